@@ -20,6 +20,8 @@ struct Command {
   std::string summary;
   std::string source_file;  // __FILE__ of the command, to list its flags in --help
   int (*run)(const CommandContext& context);
+  // Names of the flags from common_flags.h this command takes.
+  std::vector<std::string> shared_flags;
 };
 
 // Registers a command at static-initialisation time; returns true.
@@ -28,8 +30,10 @@ const std::vector<Command>& RegisteredCommands();
 
 }  // namespace pldvo
 
-#define PLDVO_REGISTER_COMMAND(name, summary, function) \
-  static const bool kRegistered_##function =            \
-      ::pldvo::RegisterCommand({name, summary, __FILE__, &function})
+// PLDVO_REGISTER_COMMAND("run", "summary", RunCommand, "dataset", "out"): the trailing names
+// are the shared flags (common_flags.h) the command takes.
+#define PLDVO_REGISTER_COMMAND(name, summary, function, ...) \
+  static const bool kRegistered_##function =                 \
+      ::pldvo::RegisterCommand({name, summary, __FILE__, &function, {__VA_ARGS__}})
 
 #endif  // PLDVO_EXPERIMENTS_COMMAND_H_

@@ -27,7 +27,9 @@ const std::vector<Command>& RegisteredCommands() { return MutableCommands(); }
 namespace {
 
 bool IsCommandFlag(const gflags::CommandLineFlagInfo& flag, const Command& command) {
-  return flag.filename == command.source_file;
+  return flag.filename == command.source_file ||
+         std::find(command.shared_flags.begin(), command.shared_flags.end(), flag.name) !=
+             command.shared_flags.end();
 }
 
 void PrintUsage() {
@@ -37,8 +39,9 @@ void PrintUsage() {
   std::sort(commands.begin(), commands.end(),
             [](const Command& a, const Command& b) { return a.name < b.name; });
   for (const Command& command : commands) {
-    std::cout << "  " << command.name << std::string(10 - std::min<size_t>(9, command.name.size()), ' ')
-              << command.summary << "\n";
+    std::cout << "  " << command.name
+              << std::string(10 - std::min<size_t>(9, command.name.size()), ' ') << command.summary
+              << "\n";
   }
 }
 

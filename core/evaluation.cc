@@ -1,0 +1,186 @@
+#include "core/evaluation.h"
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace pldvo {
+namespace {
+
+void RequireIncreasing(const Trajectory& trajectory, const char* name) {
+  for (size_t i = 1; i < trajectory.size(); ++i) {
+    if (!(trajectory[i].timestamp > trajectory[i - 1].timestamp)) {
+      throw std::invalid_argument(std::string(name) + ": timestamps do not increase at pose " +
+                                  std::to_string(i));
+    }
+  }
+}
+
+int NearestPose(const Trajectory& trajectory, double t) {
+  const auto it = std::lower_bound(
+      trajectory.begin(), trajectory.end(), t,
+      [](const StampedPose& pose, double value) { return pose.timestamp < value; });
+  const int hi = static_cast<int>(it - trajectory.begin());
+  int best = -1;
+  double best_diff = std::numeric_limits<double>::infinity();
+  for (int i : {hi - 1, hi}) {
+    if (i < 0 || i >= static_cast<int>(trajectory.size())) continue;
+    const double diff = std::abs(trajectory[i].timestamp - t);
+    if (diff < best_diff) {
+      best_diff = diff;
+      best = i;
+    }
+  }
+  return best;
+}
+
+double Median(std::vector<double> values) {
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  double median = values[mid];
+  if (values.size() % 2 == 0) {
+    median = 0.5 * (median + *std::max_element(values.begin(), values.begin() + mid));
+  }
+  return median;
+}
+
+}  // namespace
+
+Sim3Alignment AlignUmeyama(const std::vector<Eigen::Vector3d>& src,
+                           const std::vector<Eigen::Vector3d>& dst, bool with_scale) {
+  if (src.size() != dst.size()) throw std::invalid_argument("AlignUmeyama: sizes differ");
+  if (src.size() < 3) throw std::invalid_argument("AlignUmeyama: needs at least 3 point pairs");
+  const double n = static_cast<double>(src.size());
+  Eigen::Vector3d mean_src = Eigen::Vector3d::Zero(), mean_dst = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < src.size(); ++i) {
+    mean_src += src[i];
+    mean_dst += dst[i];
+  }
+  mean_src /= n;
+  mean_dst /= n;
+  // sigma_src^2 (eq. 36) and the cross-covariance Sigma_xy (eq. 38), x = src, y = dst.
+  double src_var = 0.0;
+  Eigen::Matrix3d cross_cov = Eigen::Matrix3d::Zero();
+  for (size_t i = 0; i < src.size(); ++i) {
+    const Eigen::Vector3d src_centred = src[i] - mean_src;
+    src_var += src_centred.squaredNorm();
+    cross_cov += (dst[i] - mean_dst) * src_centred.transpose();
+  }
+  src_var /= n;
+  cross_cov /= n;
+  if (!(src_var > 0.0)) throw std::invalid_argument("AlignUmeyama: all source points coincide");
+  // Sigma_xy = U D V^T; R = U S V^T with S = diag(1, 1, det(U) det(V)) (eqs. 39-40).
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(cross_cov, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Vector3d s = Eigen::Vector3d::Ones();
+  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0.0) s(2) = -1.0;
+  Sim3Alignment alignment;
+  alignment.rotation = svd.matrixU() * s.asDiagonal() * svd.matrixV().transpose();
+  // c = tr(D S) / sigma_src^2 (eq. 42); t = mu_dst - c R mu_src (eq. 41).
+  alignment.scale = with_scale ? svd.singularValues().dot(s) / src_var : 1.0;
+  alignment.translation = mean_dst - alignment.scale * alignment.rotation * mean_src;
+  return alignment;
+}
+
+std::string EvaluationOptions::Check() const {
+  if (!(max_time_diff >= 0.0)) return "max_time_diff must be >= 0";
+  if (!(rpe_delta > 0.0)) return "rpe_delta must be > 0";
+  return "";
+}
+
+std::vector<std::pair<int, int>> AssociateByTimestamp(const Trajectory& estimate,
+                                                      const Trajectory& ground_truth,
+                                                      double max_time_diff) {
+  std::vector<std::pair<int, int>> matches;
+  for (int i = 0; i < static_cast<int>(estimate.size()); ++i) {
+    const int k = NearestPose(ground_truth, estimate[i].timestamp);
+    if (k >= 0 && std::abs(ground_truth[k].timestamp - estimate[i].timestamp) <= max_time_diff) {
+      matches.emplace_back(i, k);
+    }
+  }
+  return matches;
+}
+
+EvaluationResult EvaluateTrajectory(const Trajectory& ground_truth, const Trajectory& estimate,
+                                    const EvaluationOptions& options) {
+  const std::string problem = options.Check();
+  if (!problem.empty()) throw std::invalid_argument("evaluation options: " + problem);
+  RequireIncreasing(ground_truth, "ground truth");
+  RequireIncreasing(estimate, "estimate");
+  const std::vector<std::pair<int, int>> matches =
+      AssociateByTimestamp(estimate, ground_truth, options.max_time_diff);
+  if (matches.size() < 3) {
+    throw std::invalid_argument("only " + std::to_string(matches.size()) + " of " +
+                                std::to_string(estimate.size()) +
+                                " estimate poses have a ground-truth pose within " +
+                                std::to_string(options.max_time_diff) + " s (need 3)");
+  }
+  EvaluationResult result;
+  result.num_associated = static_cast<int>(matches.size());
+
+  // ATE after Sim(3) alignment of the estimate's positions onto the ground truth's.
+  std::vector<Eigen::Vector3d> est_positions, gt_positions;
+  for (const auto& [i, k] : matches) {
+    est_positions.push_back(estimate[i].world_from_cam.translation());
+    gt_positions.push_back(ground_truth[k].world_from_cam.translation());
+  }
+  result.gt_from_est = AlignUmeyama(est_positions, gt_positions, options.align_scale);
+  result.scale = result.gt_from_est.scale;
+  double squared_sum = 0.0;
+  for (size_t m = 0; m < matches.size(); ++m) {
+    squared_sum += (gt_positions[m] - result.gt_from_est * est_positions[m]).squaredNorm();
+  }
+  result.ate_m = std::sqrt(squared_sum / matches.size());
+
+  // The estimate's frame interval: the median time between consecutive estimate poses (robust
+  // to dropped frames as long as fewer than half the intervals are gaps).
+  std::vector<double> intervals;
+  for (size_t i = 1; i < estimate.size(); ++i) {
+    intervals.push_back(estimate[i].timestamp - estimate[i - 1].timestamp);
+  }
+  const double frame_interval = Median(intervals);
+
+  // RPE: for each associated estimate pose i, the estimate pose j nearest to t_i + delta; both
+  // associated (Sturm et al. 2012, eq. 1 with Delta = rpe_delta). E = (gt_i^-1 gt_j)^-1 (est_i^-1
+  // est_j) with the estimate's relative translation scaled by s; errors divided by the pair's
+  // interval t_j - t_i (per second).
+  std::vector<int> gt_of_estimate(estimate.size(), -1);
+  for (const auto& [i, k] : matches) gt_of_estimate[i] = k;
+  double trans_squared = 0.0, rot_squared = 0.0;
+  for (const auto& [i, k] : matches) {
+    const int j = NearestPose(estimate, estimate[i].timestamp + options.rpe_delta);
+    if (j <= i || gt_of_estimate[j] < 0) continue;
+    const double interval = estimate[j].timestamp - estimate[i].timestamp;
+    // The pose nearest to t_i + delta is at most half a frame off unless frames are missing
+    // there; then the pair is skipped (the loss shows in the coverage).
+    if (std::abs(interval - options.rpe_delta) > 0.5 * frame_interval * (1.0 + 1e-9)) continue;
+    const SE3 gt_j_from_i =
+        ground_truth[k].world_from_cam.Inverse() * ground_truth[gt_of_estimate[j]].world_from_cam;
+    const SE3 est_relative = estimate[i].world_from_cam.Inverse() * estimate[j].world_from_cam;
+    const SE3 est_j_from_i(est_relative.rotation(), result.scale * est_relative.translation());
+    const SE3 error = gt_j_from_i.Inverse() * est_j_from_i;
+    const double trans_per_s = error.translation().norm() / interval;
+    const double angle =
+        2.0 * std::atan2(error.rotation().vec().norm(), std::abs(error.rotation().w()));
+    const double rot_per_s = angle / interval;
+    trans_squared += trans_per_s * trans_per_s;
+    rot_squared += rot_per_s * rot_per_s;
+    ++result.num_pairs;
+  }
+  if (result.num_pairs > 0) {
+    result.rpe_cm_s = 100.0 * std::sqrt(trans_squared / result.num_pairs);
+    result.rpe_deg_s = 180.0 / M_PI * std::sqrt(rot_squared / result.num_pairs);
+  } else {
+    result.rpe_cm_s = std::numeric_limits<double>::quiet_NaN();
+    result.rpe_deg_s = std::numeric_limits<double>::quiet_NaN();
+  }
+
+  // Coverage: associated poses times the estimate's frame interval over the ground-truth span.
+  const double gt_span = ground_truth.back().timestamp - ground_truth.front().timestamp;
+  result.coverage =
+      std::min(1.0, result.num_associated * frame_interval / (gt_span + frame_interval));
+  return result;
+}
+
+}  // namespace pldvo

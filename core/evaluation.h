@@ -1,0 +1,85 @@
+// Trajectory evaluation as the TUM RGB-D benchmark defines it (Sturm et al., IROS 2012), for a
+// monocular estimate whose scale is unknown: association by timestamp, Umeyama Sim(3) alignment,
+// absolute trajectory error (ATE), relative pose error (RPE) per second, and coverage.
+// Definitions and units: docs/evaluation.md.
+#ifndef PLDVO_CORE_EVALUATION_H_
+#define PLDVO_CORE_EVALUATION_H_
+
+#include <Eigen/Core>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/trajectory_io.h"
+
+namespace pldvo {
+
+// p_dst = scale * rotation * p_src + translation.
+struct Sim3Alignment {
+  double scale = 1.0;
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  Eigen::Vector3d operator*(const Eigen::Vector3d& p_src) const {
+    return scale * (rotation * p_src) + translation;
+  }
+};
+
+// The closed-form least-squares similarity (Umeyama, PAMI 1991, eqs. 40-42) minimising
+// sum_i |dst_i - (s R src_i + t)|^2; with_scale = false fixes s = 1 (SE(3) alignment).
+// Throws std::invalid_argument for fewer than 3 pairs, different sizes, or all src points equal.
+Sim3Alignment AlignUmeyama(const std::vector<Eigen::Vector3d>& src,
+                           const std::vector<Eigen::Vector3d>& dst, bool with_scale = true);
+
+struct EvaluationOptions {
+  // Largest |t_est - t_gt| for an estimate pose to be associated with its nearest ground-truth
+  // pose, in seconds (TUM associate.py's default).
+  double max_time_diff = 0.02;
+  // RPE interval in seconds: the TUM benchmark's drift per second.
+  double rpe_delta = 1.0;
+  // Sim(3) alignment (monocular, scale unknown); false aligns with SE(3) and reports scale 1.
+  bool align_scale = true;
+
+  template <class Visitor>
+  void VisitFields(Visitor& v) {
+    v.Field("max_time_diff", &max_time_diff,
+            "Largest timestamp difference (s) to associate an estimate pose with ground truth.");
+    v.Field("rpe_delta", &rpe_delta, "RPE interval in seconds (errors are reported per second).");
+    v.Field("align_scale", &align_scale,
+            "Align with Sim(3) (true, monocular) or SE(3) (false) before ATE and RPE.");
+  }
+  // "" when valid, otherwise what is wrong.
+  std::string Check() const;
+};
+
+struct EvaluationResult {
+  // RMSE of the associated positions after alignment, in metres of the ground truth.
+  double ate_m = 0.0;
+  // RMSE over pose pairs rpe_delta apart of the relative translational error per second (cm/s,
+  // the estimate scaled by the alignment's scale) and of the relative rotation angle per second
+  // (deg/s). NaN when no pair exists (estimate shorter than rpe_delta).
+  double rpe_cm_s = 0.0;
+  double rpe_deg_s = 0.0;
+  // The alignment's scale: ground-truth metres per estimate unit.
+  double scale = 1.0;
+  // Fraction of the ground-truth time span covered by associated estimate poses, in [0, 1]:
+  // num_associated * dt / (gt_span + dt), dt the median interval between estimate poses.
+  double coverage = 0.0;
+  int num_pairs = 0;       // RPE pairs
+  int num_associated = 0;  // estimate poses associated with ground truth
+  Sim3Alignment gt_from_est;
+};
+
+// (estimate index, ground-truth index) pairs: each estimate pose with the nearest ground-truth
+// pose within max_time_diff. Both trajectories must have increasing timestamps.
+std::vector<std::pair<int, int>> AssociateByTimestamp(const Trajectory& estimate,
+                                                      const Trajectory& ground_truth,
+                                                      double max_time_diff);
+
+// Throws std::invalid_argument when fewer than 3 estimate poses can be associated, the
+// timestamps do not increase, or the options are invalid.
+EvaluationResult EvaluateTrajectory(const Trajectory& ground_truth, const Trajectory& estimate,
+                                    const EvaluationOptions& options = {});
+
+}  // namespace pldvo
+
+#endif  // PLDVO_CORE_EVALUATION_H_

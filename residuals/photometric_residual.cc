@@ -1,0 +1,164 @@
+#include "residuals/photometric_residual.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "residuals/robustify.h"
+#include "residuals/se3_manifold.h"
+
+namespace pldvo {
+namespace {
+
+// Sampling area [1, w - 2) x [1, h - 2): bilinear lookups then touch only pixels whose
+// central-difference gradient is defined (ImagePyramid leaves the one-pixel border at 0).
+constexpr double kSamplingBorder = 1.0;
+
+[[noreturn]] void ThrowInvalid(int line, const std::string& what) {
+  std::ostringstream message;
+  message << __FILE__ << ":" << line << ": PhotometricResidual: " << what;
+  throw std::invalid_argument(message.str());
+}
+
+}  // namespace
+
+PhotometricResidual::PhotometricResidual(const ImagePyramid& cur_pyramid, int level,
+                                         const PinholeCamera& camera,
+                                         std::vector<PhotometricObservation> observations,
+                                         const ceres::LossFunction* loss)
+    : cur_pyramid_(cur_pyramid),
+      level_(level),
+      camera_(camera),
+      observations_(std::move(observations)),
+      loss_(loss) {
+  if (observations_.empty()) ThrowInvalid(__LINE__, "empty batch");
+  if (level < 0 || level >= cur_pyramid.num_levels()) {
+    ThrowInvalid(__LINE__, "level " + std::to_string(level) + " outside the pyramid's " +
+                               std::to_string(cur_pyramid.num_levels()) + " levels");
+  }
+  const std::string camera_error = camera.Check();
+  if (!camera_error.empty()) ThrowInvalid(__LINE__, "camera: " + camera_error);
+  if (camera.width != cur_pyramid.width(level) || camera.height != cur_pyramid.height(level)) {
+    ThrowInvalid(__LINE__, "camera size " + std::to_string(camera.width) + "x" +
+                               std::to_string(camera.height) + " differs from level " +
+                               std::to_string(level) + " size " +
+                               std::to_string(cur_pyramid.width(level)) + "x" +
+                               std::to_string(cur_pyramid.height(level)));
+  }
+  rays_in_ref_.reserve(observations_.size());
+  for (size_t i = 0; i < observations_.size(); ++i) {
+    const PhotometricObservation& o = observations_[i];
+    if (!o.pixel_in_ref.allFinite() || !std::isfinite(o.intensity_ref) || !(o.idepth >= 0.0) ||
+        !std::isfinite(o.idepth) || !(o.sqrt_info >= 0.0) || !std::isfinite(o.sqrt_info)) {
+      ThrowInvalid(__LINE__, "observation " + std::to_string(i) +
+                                 " has a non-finite value, a negative idepth or sqrt_info");
+    }
+    rays_in_ref_.push_back(camera_.Unproject(o.pixel_in_ref));
+  }
+  valid_.assign(observations_.size(), 0);
+  set_num_residuals(static_cast<int>(observations_.size()));
+  mutable_parameter_block_sizes()->push_back(kPoseAmbientSize);
+}
+
+namespace {
+
+// One row: residual and (optionally) its tangent Jacobian. Returns validity.
+inline bool PhotometricRow(const ImagePyramid& pyramid, int level, const PinholeCamera& camera,
+                           const PhotometricObservation& o, const Eigen::Vector3d& ray_in_ref,
+                           const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation,
+                           const ceres::LossFunction* loss, double* residual,
+                           double* jacobian_tangent) {
+  // q = R K^-1 (x; 1) + d t = d * point_in_cur.
+  const Eigen::Vector3d q = rotation * ray_in_ref + o.idepth * translation;
+  const double u_over = q.x() / q.z();
+  const double v_over = q.y() / q.z();
+  const double u = camera.fx * u_over + camera.cx;
+  const double v = camera.fy * v_over + camera.cy;
+  const double max_u = camera.width - 1 - kSamplingBorder;
+  const double max_v = camera.height - 1 - kSamplingBorder;
+  if (!(q.z() > 0.0) || !(u >= kSamplingBorder && v >= kSamplingBorder && u < max_u && v < max_v)) {
+    *residual = 0.0;
+    if (jacobian_tangent != nullptr) std::fill(jacobian_tangent, jacobian_tangent + 6, 0.0);
+    return false;
+  }
+  const Eigen::Vector3f sample = pyramid.Sample(level, u, v);
+  double scale;
+  *residual = RobustifyRow(loss, o.sqrt_info * (o.intensity_ref - sample[0]), &scale);
+  if (jacobian_tangent != nullptr) {
+    // c = g^T dpi/dq (1x3); dr/dxi = -w [d c, (q x c)^T] since c^T (-[q]x) = (q x c)^T.
+    const double inv_z = 1.0 / q.z();
+    const double gfx = sample[1] * camera.fx * inv_z;
+    const double gfy = sample[2] * camera.fy * inv_z;
+    const Eigen::Vector3d c(gfx, gfy, -(gfx * u_over + gfy * v_over));
+    const double w = -o.sqrt_info * scale;
+    Eigen::Map<Eigen::Matrix<double, 6, 1>> row(jacobian_tangent);
+    row.head<3>() = (w * o.idepth) * c;
+    row.tail<3>() = w * q.cross(c);
+  }
+  return true;
+}
+
+}  // namespace
+
+bool PhotometricResidual::Evaluate(double const* const* parameters, double* residuals,
+                                   double** jacobians) const {
+  const SE3 cur_from_ref = PoseFromParameters(parameters[0]);
+  const Eigen::Matrix3d rotation = cur_from_ref.rotation_matrix();
+  const Eigen::Vector3d& translation = cur_from_ref.translation();
+  double* jacobian = (jacobians != nullptr) ? jacobians[0] : nullptr;
+  const MinusJacobianMatrix minus_jacobian =
+      jacobian != nullptr ? PoseMinusJacobian(parameters[0]) : MinusJacobianMatrix::Zero();
+  double row_tangent[kPoseTangentSize];
+  const int n = num_observations();
+  for (int i = 0; i < n; ++i) {
+    valid_[i] = PhotometricRow(cur_pyramid_, level_, camera_, observations_[i], rays_in_ref_[i],
+                               rotation, translation, loss_, residuals + i,
+                               jacobian != nullptr ? row_tangent : nullptr);
+    if (jacobian != nullptr) {
+      LiftTangentJacobian(minus_jacobian, row_tangent, 1, jacobian + i * kPoseAmbientSize);
+    }
+  }
+  return true;
+}
+
+void PhotometricResidual::EvaluateTangent(const SE3& cur_from_ref, double* residuals,
+                                          double* jacobian_tangent, std::uint8_t* valid) const {
+  const Eigen::Matrix3d rotation = cur_from_ref.rotation_matrix();
+  const Eigen::Vector3d& translation = cur_from_ref.translation();
+  const int n = num_observations();
+  for (int i = 0; i < n; ++i) {
+    const bool ok = PhotometricRow(
+        cur_pyramid_, level_, camera_, observations_[i], rays_in_ref_[i], rotation, translation,
+        loss_, residuals + i,
+        jacobian_tangent != nullptr ? jacobian_tangent + i * kPoseTangentSize : nullptr);
+    if (valid != nullptr) valid[i] = ok;
+  }
+}
+
+std::vector<Eigen::Vector2d> PhotometricResidual::ReprojectedPixels(
+    const SE3& cur_from_ref, std::vector<std::uint8_t>* valid) const {
+  std::vector<double> residuals(observations_.size());
+  std::vector<std::uint8_t> row_valid(observations_.size());
+  EvaluateTangent(cur_from_ref, residuals.data(), nullptr, row_valid.data());
+  const Eigen::Matrix3d rotation = cur_from_ref.rotation_matrix();
+  std::vector<Eigen::Vector2d> pixels(observations_.size());
+  for (size_t i = 0; i < observations_.size(); ++i) {
+    const Eigen::Vector3d q =
+        rotation * rays_in_ref_[i] + observations_[i].idepth * cur_from_ref.translation();
+    pixels[i] = q.z() > 0.0 ? camera_.Project(q)
+                            : Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  }
+  if (valid != nullptr) *valid = std::move(row_valid);
+  return pixels;
+}
+
+int PhotometricResidual::num_valid() const {
+  int count = 0;
+  for (const std::uint8_t v : valid_) count += v;
+  return count;
+}
+
+}  // namespace pldvo

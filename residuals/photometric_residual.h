@@ -1,0 +1,111 @@
+// Photometric residual of a batch of reference pixels against the current image
+// (Yang & Scherer, ICRA 2017, Sec. IV, eqs. 1-7: the photometric term r_i, weighted by the
+// semi-dense VO observation model; see docs/residuals.md):
+//
+//   r_i = sqrt_info_i * (I_ref(x_i) - I_cur(tau(x_i, d_i, xi))),   i = 1..N,
+//   tau(x, d, xi) = pi(T(xi) pi^-1(x, d)),
+//
+// computed as pi(R K^-1 (x; 1) + d t) (valid for d = 0, a point at infinity).
+//
+// Parameter block: one pose, double[7] = [t; q] = cur_from_ref (residuals/se3_manifold.h; use
+// SE3Manifold). Jacobian in the tangent space (left twist, translation first):
+//   dr_i/dxi = -sqrt_info_i g^T dpi/dp [I, -[p']x],  p' = cur_from_ref * pi^-1(x_i, d_i),
+// where g = (Ix, Iy) is the bilinearly interpolated precomputed central-difference gradient of
+// the current image (ImagePyramid), lifted to the 7 parameters by J_tangent * MinusJacobian(x).
+//
+// Weighting: sqrt_info_i is given by the caller, computed at the linearisation point from the
+// covariance model (PhotometricVariance; see residuals/weighting.h) and held constant inside a
+// solve.
+//
+// Robust loss (optional, not owned, must outlive this object): applied ROW-WISE inside the cost
+// function in square-root form on the whitened residual r = r_i,
+//   r~ = sign(r) sqrt(rho(r^2)),   dr~/dr = rho'(r^2) |r| / sqrt(rho(r^2))  (-> sqrt(rho'(0)) = 1
+// as r -> 0), so sum_i r~_i^2 = sum_i rho(r_i^2) exactly and the gradient of the cost is exactly
+// that of the robust cost; every pixel of a batch keeps its own robustness. With N = 1 the
+// caller may instead pass the loss to ceres::Problem::AddResidualBlock (and nullptr here); do
+// not do both.
+//
+// Validity: a row whose reprojection falls behind the camera (z <= 0) or outside the sampling
+// area [1, w - 2) x [1, h - 2) of the level (where the precomputed gradient is defined) gets
+// residual 0 and Jacobian row 0, and valid(i) == false. valid() reflects the most recent
+// Evaluate() call (which may be a rejected trial step of the solver); it is not thread-safe
+// when one object is shared by several residual blocks. EvaluateTangent() writes validity to a
+// caller buffer instead and is const-thread-safe.
+//
+// Evaluate() does no heap allocation. The current pyramid must outlive this object.
+#ifndef PLDVO_RESIDUALS_PHOTOMETRIC_RESIDUAL_H_
+#define PLDVO_RESIDUALS_PHOTOMETRIC_RESIDUAL_H_
+
+#include <ceres/cost_function.h>
+#include <ceres/loss_function.h>
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "core/image_pyramid.h"
+#include "core/pinhole_camera.h"
+#include "core/se3.h"
+
+namespace pldvo {
+
+// One reference pixel of the photometric batch.
+struct PhotometricObservation {
+  Eigen::Vector2d pixel_in_ref = Eigen::Vector2d::Zero();  // at the residual's pyramid level
+  double idepth = 0.0;                                     // inverse depth in ref, >= 0
+  double intensity_ref = 0.0;                              // I_ref(x), gray levels
+  double sqrt_info = 1.0;                                  // 1 / sqrt(Sigma_r), >= 0
+};
+
+class PhotometricResidual : public ceres::CostFunction {
+ public:
+  // `camera` is the camera of `level` (PinholeCamera::AtLevel). Throws std::invalid_argument on
+  // an empty batch, a level outside the pyramid, a camera whose size differs from the level's,
+  // or a non-finite / negative idepth or sqrt_info.
+  PhotometricResidual(const ImagePyramid& cur_pyramid, int level, const PinholeCamera& camera,
+                      std::vector<PhotometricObservation> observations,
+                      const ceres::LossFunction* loss = nullptr);
+
+  static PhotometricResidual* Create(const ImagePyramid& cur_pyramid, int level,
+                                     const PinholeCamera& camera,
+                                     std::vector<PhotometricObservation> observations,
+                                     const ceres::LossFunction* loss = nullptr) {
+    return new PhotometricResidual(cur_pyramid, level, camera, std::move(observations), loss);
+  }
+
+  // parameters[0] = cur_from_ref (7). jacobians[0], if requested, is N x 7 row-major.
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+  // The same rows for a pose given as SE3, with the Jacobian in the tangent space
+  // (N x 6 row-major, may be nullptr) and validity written to `valid` (N entries, may be
+  // nullptr). For Gauss-Newton solvers that work in the tangent space directly.
+  void EvaluateTangent(const SE3& cur_from_ref, double* residuals, double* jacobian_tangent,
+                       std::uint8_t* valid) const;
+
+  // The reprojected pixels tau(x_i, d_i, xi) for a pose (the paper's Fig. 2 iteration images),
+  // with their validity (same rule as in Evaluate); NaN behind the camera. Allocates; not for
+  // hot loops.
+  std::vector<Eigen::Vector2d> ReprojectedPixels(const SE3& cur_from_ref,
+                                                 std::vector<std::uint8_t>* valid = nullptr) const;
+
+  int num_observations() const { return static_cast<int>(observations_.size()); }
+  const std::vector<PhotometricObservation>& observations() const { return observations_; }
+  // Validity of row i after the most recent Evaluate() (see the header comment).
+  bool valid(int i) const { return valid_[i] != 0; }
+  int num_valid() const;
+
+ private:
+  const ImagePyramid& cur_pyramid_;
+  const int level_;
+  const PinholeCamera camera_;
+  const std::vector<PhotometricObservation> observations_;
+  // K^-1 (x; 1) of every observation, precomputed.
+  std::vector<Eigen::Vector3d> rays_in_ref_;
+  const ceres::LossFunction* loss_;
+  mutable std::vector<std::uint8_t> valid_;
+};
+
+}  // namespace pldvo
+
+#endif  // PLDVO_RESIDUALS_PHOTOMETRIC_RESIDUAL_H_

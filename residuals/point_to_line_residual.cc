@@ -1,0 +1,139 @@
+#include "residuals/point_to_line_residual.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "residuals/robustify.h"
+#include "residuals/se3_manifold.h"
+
+namespace pldvo {
+namespace {
+
+[[noreturn]] void ThrowInvalid(int line, const std::string& what) {
+  std::ostringstream message;
+  message << __FILE__ << ":" << line << ": PointToLineResidual: " << what;
+  throw std::invalid_argument(message.str());
+}
+
+// One row: residual and (optionally) its tangent Jacobian. Returns validity.
+inline bool PointToLineRow(const PinholeCamera& camera, const PointToLineObservation& o,
+                           const Eigen::Vector3d& ray_in_ref, const Eigen::Matrix3d& rotation,
+                           const Eigen::Vector3d& translation, const ceres::LossFunction* loss,
+                           double* residual, double* jacobian_tangent) {
+  const Eigen::Vector3d q = rotation * ray_in_ref + o.idepth * translation;
+  const double u_over = q.x() / q.z();
+  const double v_over = q.y() / q.z();
+  const double u = camera.fx * u_over + camera.cx;
+  const double v = camera.fy * v_over + camera.cy;
+  if (!(q.z() > 0.0) ||
+      !(u >= 0.0 && v >= 0.0 && u <= camera.width - 1 && v <= camera.height - 1)) {
+    *residual = 0.0;
+    if (jacobian_tangent != nullptr) std::fill(jacobian_tangent, jacobian_tangent + 6, 0.0);
+    return false;
+  }
+  const Eigen::Vector3d& l = o.line_in_cur;
+  double scale;
+  *residual = RobustifyRow(loss, o.sqrt_info * (l.x() * u + l.y() * v + l.z()), &scale);
+  if (jacobian_tangent != nullptr) {
+    // c = (a, b) dpi/dq (1x3); dg/dxi = w [d c, (q x c)^T].
+    const double inv_z = 1.0 / q.z();
+    const double afx = l.x() * camera.fx * inv_z;
+    const double bfy = l.y() * camera.fy * inv_z;
+    const Eigen::Vector3d c(afx, bfy, -(afx * u_over + bfy * v_over));
+    const double w = o.sqrt_info * scale;
+    Eigen::Map<Eigen::Matrix<double, 6, 1>> row(jacobian_tangent);
+    row.head<3>() = (w * o.idepth) * c;
+    row.tail<3>() = w * q.cross(c);
+  }
+  return true;
+}
+
+}  // namespace
+
+PointToLineResidual::PointToLineResidual(const PinholeCamera& camera,
+                                         std::vector<PointToLineObservation> observations,
+                                         const ceres::LossFunction* loss)
+    : camera_(camera), observations_(std::move(observations)), loss_(loss) {
+  if (observations_.empty()) ThrowInvalid(__LINE__, "empty batch");
+  const std::string camera_error = camera.Check();
+  if (!camera_error.empty()) ThrowInvalid(__LINE__, "camera: " + camera_error);
+  rays_in_ref_.reserve(observations_.size());
+  for (size_t i = 0; i < observations_.size(); ++i) {
+    const PointToLineObservation& o = observations_[i];
+    if (!o.pixel_in_ref.allFinite() || !o.line_in_cur.allFinite() || !(o.idepth >= 0.0) ||
+        !std::isfinite(o.idepth) || !(o.sqrt_info >= 0.0) || !std::isfinite(o.sqrt_info)) {
+      ThrowInvalid(__LINE__, "observation " + std::to_string(i) +
+                                 " has a non-finite value, a negative idepth or sqrt_info");
+    }
+    if (!(std::abs(o.line_in_cur.head<2>().squaredNorm() - 1.0) <= 1e-6)) {
+      ThrowInvalid(__LINE__, "observation " + std::to_string(i) +
+                                 ": line must be normalised to a^2 + b^2 = 1");
+    }
+    rays_in_ref_.push_back(camera_.Unproject(o.pixel_in_ref));
+  }
+  valid_.assign(observations_.size(), 0);
+  set_num_residuals(static_cast<int>(observations_.size()));
+  mutable_parameter_block_sizes()->push_back(kPoseAmbientSize);
+}
+
+bool PointToLineResidual::Evaluate(double const* const* parameters, double* residuals,
+                                   double** jacobians) const {
+  const SE3 cur_from_ref = PoseFromParameters(parameters[0]);
+  const Eigen::Matrix3d rotation = cur_from_ref.rotation_matrix();
+  const Eigen::Vector3d& translation = cur_from_ref.translation();
+  double* jacobian = (jacobians != nullptr) ? jacobians[0] : nullptr;
+  const MinusJacobianMatrix minus_jacobian =
+      jacobian != nullptr ? PoseMinusJacobian(parameters[0]) : MinusJacobianMatrix::Zero();
+  double row_tangent[kPoseTangentSize];
+  const int n = num_observations();
+  for (int i = 0; i < n; ++i) {
+    valid_[i] = PointToLineRow(camera_, observations_[i], rays_in_ref_[i], rotation, translation,
+                               loss_, residuals + i, jacobian != nullptr ? row_tangent : nullptr);
+    if (jacobian != nullptr) {
+      LiftTangentJacobian(minus_jacobian, row_tangent, 1, jacobian + i * kPoseAmbientSize);
+    }
+  }
+  return true;
+}
+
+void PointToLineResidual::EvaluateTangent(const SE3& cur_from_ref, double* residuals,
+                                          double* jacobian_tangent, std::uint8_t* valid) const {
+  const Eigen::Matrix3d rotation = cur_from_ref.rotation_matrix();
+  const Eigen::Vector3d& translation = cur_from_ref.translation();
+  const int n = num_observations();
+  for (int i = 0; i < n; ++i) {
+    const bool ok = PointToLineRow(
+        camera_, observations_[i], rays_in_ref_[i], rotation, translation, loss_, residuals + i,
+        jacobian_tangent != nullptr ? jacobian_tangent + i * kPoseTangentSize : nullptr);
+    if (valid != nullptr) valid[i] = ok;
+  }
+}
+
+std::vector<Eigen::Vector2d> PointToLineResidual::ReprojectedPixels(
+    const SE3& cur_from_ref, std::vector<std::uint8_t>* valid) const {
+  std::vector<double> residuals(observations_.size());
+  std::vector<std::uint8_t> row_valid(observations_.size());
+  EvaluateTangent(cur_from_ref, residuals.data(), nullptr, row_valid.data());
+  const Eigen::Matrix3d rotation = cur_from_ref.rotation_matrix();
+  std::vector<Eigen::Vector2d> pixels(observations_.size());
+  for (size_t i = 0; i < observations_.size(); ++i) {
+    const Eigen::Vector3d q =
+        rotation * rays_in_ref_[i] + observations_[i].idepth * cur_from_ref.translation();
+    pixels[i] = q.z() > 0.0 ? camera_.Project(q)
+                            : Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  }
+  if (valid != nullptr) *valid = std::move(row_valid);
+  return pixels;
+}
+
+int PointToLineResidual::num_valid() const {
+  int count = 0;
+  for (const std::uint8_t v : valid_) count += v;
+  return count;
+}
+
+}  // namespace pldvo

@@ -1,0 +1,87 @@
+// Point-to-line residual of a batch of reference edge pixels against matched current-frame
+// lines (Yang & Scherer, ICRA 2017, Sec. IV, eqs. 1-7: the geometric term g_j and its weight;
+// see docs/residuals.md):
+//
+//   g_j = sqrt_info_j * l_j^T (tau(x_j, d_j, xi); 1),   j = 1..N,
+//
+// with l_j = (a, b, c), a^2 + b^2 = 1, so l_j^T (u, v, 1) is the signed pixel distance of the
+// reprojected edge pixel to the line (covariance_models.h FitLine), and
+// tau(x, d, xi) = pi(R K^-1 (x; 1) + d t) as in photometric_residual.h.
+//
+// Parameter block: one pose, double[7] = cur_from_ref (SE3Manifold). Tangent Jacobian
+//   dg_j/dxi = sqrt_info_j (a, b) dpi/dp [I, -[p']x],
+// lifted to the 7 parameters by J_tangent * MinusJacobian(x).
+//
+// Weighting: sqrt_info_j = 1 / sqrt(Sigma_g) from PointToLineVariance (weighting.h), computed
+// by the caller at the linearisation point and held constant inside a solve.
+// Robust loss (optional, not owned): row-wise square-root form, exactly as in
+// photometric_residual.h (residuals/robustify.h).
+// Validity: behind the camera (z <= 0) or outside the level's image [0, w - 1] x [0, h - 1]
+// -> residual 0, Jacobian row 0, valid(i) false; same rules as PhotometricResidual.
+// Evaluate() does no heap allocation.
+#ifndef PLDVO_RESIDUALS_POINT_TO_LINE_RESIDUAL_H_
+#define PLDVO_RESIDUALS_POINT_TO_LINE_RESIDUAL_H_
+
+#include <ceres/cost_function.h>
+#include <ceres/loss_function.h>
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "core/pinhole_camera.h"
+#include "core/se3.h"
+
+namespace pldvo {
+
+// One reference edge pixel with its matched current-frame line.
+struct PointToLineObservation {
+  Eigen::Vector2d pixel_in_ref = Eigen::Vector2d::Zero();  // at the residual's pyramid level
+  double idepth = 0.0;                                     // inverse depth in ref, >= 0
+  Eigen::Vector3d line_in_cur = Eigen::Vector3d::Zero();   // a^2 + b^2 = 1, same level's pixels
+  double sqrt_info = 1.0;                                  // 1 / sqrt(Sigma_g) in 1/px, >= 0
+};
+
+class PointToLineResidual : public ceres::CostFunction {
+ public:
+  // `camera` is the camera of the level the pixels and lines are expressed in. Throws
+  // std::invalid_argument on an empty batch, an invalid camera, |a^2 + b^2 - 1| > 1e-6, or a
+  // non-finite / negative idepth or sqrt_info.
+  PointToLineResidual(const PinholeCamera& camera, std::vector<PointToLineObservation> observations,
+                      const ceres::LossFunction* loss = nullptr);
+
+  static PointToLineResidual* Create(const PinholeCamera& camera,
+                                     std::vector<PointToLineObservation> observations,
+                                     const ceres::LossFunction* loss = nullptr) {
+    return new PointToLineResidual(camera, std::move(observations), loss);
+  }
+
+  // parameters[0] = cur_from_ref (7). jacobians[0], if requested, is N x 7 row-major.
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+  // Tangent-space evaluation (N x 6 row-major Jacobian, may be nullptr; `valid` may be nullptr).
+  void EvaluateTangent(const SE3& cur_from_ref, double* residuals, double* jacobian_tangent,
+                       std::uint8_t* valid) const;
+
+  // The reprojected edge pixels for a pose, with their validity; NaN behind the camera.
+  // Allocates.
+  std::vector<Eigen::Vector2d> ReprojectedPixels(const SE3& cur_from_ref,
+                                                 std::vector<std::uint8_t>* valid = nullptr) const;
+
+  int num_observations() const { return static_cast<int>(observations_.size()); }
+  const std::vector<PointToLineObservation>& observations() const { return observations_; }
+  bool valid(int i) const { return valid_[i] != 0; }
+  int num_valid() const;
+
+ private:
+  const PinholeCamera camera_;
+  const std::vector<PointToLineObservation> observations_;
+  std::vector<Eigen::Vector3d> rays_in_ref_;
+  const ceres::LossFunction* loss_;
+  mutable std::vector<std::uint8_t> valid_;
+};
+
+}  // namespace pldvo
+
+#endif  // PLDVO_RESIDUALS_POINT_TO_LINE_RESIDUAL_H_

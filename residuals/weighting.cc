@@ -1,0 +1,110 @@
+#include "residuals/weighting.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace pldvo {
+namespace {
+
+bool PositiveFinite(double value) { return value > 0.0 && std::isfinite(value); }
+
+// 1 / sqrt(var), 0 for a non-positive or non-finite variance (no information).
+double InverseSqrt(double var) { return PositiveFinite(var) ? 1.0 / std::sqrt(var) : 0.0; }
+
+}  // namespace
+
+std::string WeightingOptions::Check() const {
+  std::ostringstream error;
+  if (!PositiveFinite(sigma_intensity)) {
+    error << "sigma_intensity must be positive and finite, got " << sigma_intensity << "; ";
+  }
+  if (!PositiveFinite(line_sigma_px)) {
+    error << "line_sigma_px must be positive and finite, got " << line_sigma_px << "; ";
+  }
+  if (!(fixed_ratio_lambda >= 0.0) || !std::isfinite(fixed_ratio_lambda)) {
+    error << "fixed_ratio_lambda must be >= 0 and finite, got " << fixed_ratio_lambda << "; ";
+  }
+  if (robust_loss != RobustLossKind::kNone && !PositiveFinite(robust_threshold)) {
+    error << "robust_threshold must be positive and finite, got " << robust_threshold << "; ";
+  }
+  return error.str();
+}
+
+double LineSigmaAtLevel(const WeightingOptions& options, int level) {
+  return std::ldexp(options.line_sigma_px, -level);
+}
+
+std::unique_ptr<ceres::LossFunction> MakeLossFunction(const WeightingOptions& options) {
+  switch (options.robust_loss) {
+    case RobustLossKind::kNone:
+      return nullptr;
+    case RobustLossKind::kHuber:
+      return std::make_unique<ceres::HuberLoss>(options.robust_threshold);
+    case RobustLossKind::kCauchy:
+      return std::make_unique<ceres::CauchyLoss>(options.robust_threshold);
+  }
+  return nullptr;
+}
+
+double PhotometricSqrtInfo(const WeightingOptions& options, const Eigen::Vector2d& gradient_cur,
+                           const Eigen::Vector2d& pixel_idepth_jacobian, double idepth_var) {
+  switch (options.policy) {
+    case WeightingPolicy::kCovariance:
+    case WeightingPolicy::kPhotometricOnly:
+      return InverseSqrt(PhotometricVariance(options.sigma_intensity, gradient_cur,
+                                             pixel_idepth_jacobian, idepth_var));
+    case WeightingPolicy::kUniform:
+      return 1.0;
+    case WeightingPolicy::kFixedRatio:
+      return 1.0 / options.sigma_intensity;
+    case WeightingPolicy::kLineOnly:
+      return 0.0;
+  }
+  return 0.0;
+}
+
+double PhotometricSqrtInfo(const WeightingOptions& options, const PinholeCamera& camera,
+                           const ImagePyramid& cur_pyramid, int level, const SE3& cur_from_ref,
+                           const Eigen::Vector2d& pixel_in_ref, double idepth, double idepth_var) {
+  Eigen::Vector2d pixel_cur;
+  if (!Reproject(camera, cur_from_ref, pixel_in_ref, idepth, &pixel_cur)) return 0.0;
+  // Same sampling area as PhotometricResidual.
+  if (!(pixel_cur.x() >= 1.0 && pixel_cur.y() >= 1.0 && pixel_cur.x() < camera.width - 2 &&
+        pixel_cur.y() < camera.height - 2)) {
+    return 0.0;
+  }
+  const Eigen::Vector3f sample = cur_pyramid.Sample(level, pixel_cur.x(), pixel_cur.y());
+  const Eigen::Vector2d gradient(sample[1], sample[2]);
+  return PhotometricSqrtInfo(options, gradient,
+                             ReprojectionIdepthJacobian(camera, cur_from_ref, pixel_in_ref, idepth),
+                             idepth_var);
+}
+
+double LineSqrtInfo(const WeightingOptions& options, const LineWithCovariance& line_in_cur,
+                    const Eigen::Vector2d& pixel_cur, const Eigen::Matrix3d& pixel_cov) {
+  switch (options.policy) {
+    case WeightingPolicy::kCovariance:
+    case WeightingPolicy::kLineOnly:
+      return InverseSqrt(
+          PointToLineVariance(line_in_cur.line, line_in_cur.cov, pixel_cur, pixel_cov));
+    case WeightingPolicy::kUniform:
+      return 1.0;
+    case WeightingPolicy::kFixedRatio:
+      return std::sqrt(options.fixed_ratio_lambda) / options.line_sigma_px;
+    case WeightingPolicy::kPhotometricOnly:
+      return 0.0;
+  }
+  return 0.0;
+}
+
+double LineSqrtInfo(const WeightingOptions& options, const PinholeCamera& camera,
+                    const SE3& cur_from_ref, const Eigen::Vector2d& pixel_in_ref, double idepth,
+                    double idepth_var, const LineWithCovariance& line_in_cur) {
+  Eigen::Vector2d pixel_cur;
+  if (!Reproject(camera, cur_from_ref, pixel_in_ref, idepth, &pixel_cur)) return 0.0;
+  return LineSqrtInfo(
+      options, line_in_cur, pixel_cur,
+      ReprojectedPixelCovariance(camera, cur_from_ref, pixel_in_ref, idepth, idepth_var));
+}
+
+}  // namespace pldvo

@@ -1,0 +1,217 @@
+#include "core/evaluation.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace pldvo {
+namespace {
+
+// Every expected value below is exact in real arithmetic; 1e-9 leaves room for the rounding of
+// an SVD and of sums over a few hundred poses (errors near 1e-13).
+constexpr double kTolerance = 1e-9;
+
+StampedPose Pose(double t, const Eigen::Vector3d& position,
+                 const Eigen::Quaterniond& rotation = Eigen::Quaterniond::Identity()) {
+  StampedPose pose;
+  pose.timestamp = t;
+  pose.world_from_cam = SE3(rotation, position);
+  return pose;
+}
+
+// A smooth non-planar path (so the alignment is unique) with a turning camera, 10 Hz.
+Trajectory CurvedTrajectory(int n) {
+  Trajectory trajectory;
+  for (int i = 0; i < n; ++i) {
+    const double t = 0.1 * i;
+    trajectory.push_back(Pose(
+        t, Eigen::Vector3d(std::cos(0.3 * t), std::sin(0.5 * t), 0.2 * t),
+        Eigen::Quaterniond(Eigen::AngleAxisd(0.1 * t, Eigen::Vector3d(0.3, 1, 0.2).normalized()))));
+  }
+  return trajectory;
+}
+
+// world' = s R world + t applied to a trajectory (positions scaled, orientations rotated).
+Trajectory Transform(const Trajectory& trajectory, double s, const Eigen::Matrix3d& rotation,
+                     const Eigen::Vector3d& translation) {
+  Trajectory out;
+  for (const StampedPose& pose : trajectory) {
+    out.push_back(Pose(pose.timestamp,
+                       s * rotation * pose.world_from_cam.translation() + translation,
+                       Eigen::Quaterniond(rotation) * pose.world_from_cam.rotation()));
+  }
+  return out;
+}
+
+TEST(AlignUmeyama, RecoversAKnownSimilarity) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> normal;
+  std::vector<Eigen::Vector3d> src, dst;
+  const Eigen::Matrix3d rotation =
+      Eigen::AngleAxisd(2.0, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
+  const Eigen::Vector3d translation(3, -1, 7);
+  for (int i = 0; i < 20; ++i) {
+    src.emplace_back(normal(rng), normal(rng), normal(rng));
+    dst.push_back(0.3 * rotation * src.back() + translation);
+  }
+  const Sim3Alignment alignment = AlignUmeyama(src, dst);
+  EXPECT_NEAR(alignment.scale, 0.3, kTolerance);
+  EXPECT_LT((alignment.rotation - rotation).norm(), kTolerance);
+  EXPECT_LT((alignment.translation - translation).norm(), kTolerance);
+}
+
+TEST(AlignUmeyama, ReflectionIsNotReturned) {
+  // dst is a mirror image of src: the best proper rotation has det +1 (Umeyama's S matrix).
+  std::vector<Eigen::Vector3d> src = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}, {-1, 2, 0}};
+  std::vector<Eigen::Vector3d> dst;
+  for (const auto& p : src) dst.emplace_back(p.x(), p.y(), -p.z());
+  const Sim3Alignment alignment = AlignUmeyama(src, dst);
+  EXPECT_NEAR(alignment.rotation.determinant(), 1.0, kTolerance);
+}
+
+TEST(AlignUmeyama, DegenerateInputsThrow) {
+  EXPECT_THROW(AlignUmeyama({{0, 0, 0}, {1, 0, 0}}, {{0, 0, 0}, {1, 0, 0}}), std::invalid_argument);
+  EXPECT_THROW(AlignUmeyama({{1, 1, 1}, {1, 1, 1}, {1, 1, 1}}, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}),
+               std::invalid_argument);
+}
+
+TEST(EvaluateTrajectory, HalfScaleEstimateHasScaleTwoAndZeroAte) {
+  const Trajectory gt = CurvedTrajectory(100);
+  const Trajectory est = Transform(gt, 0.5, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+  const EvaluationResult result = EvaluateTrajectory(gt, est);
+  EXPECT_NEAR(result.scale, 2.0, kTolerance);
+  EXPECT_NEAR(result.ate_m, 0.0, kTolerance);
+  EXPECT_NEAR(result.rpe_cm_s, 0.0, kTolerance);
+  EXPECT_NEAR(result.rpe_deg_s, 0.0, kTolerance);
+  EXPECT_EQ(result.num_associated, 100);
+  EXPECT_NEAR(result.coverage, 1.0, kTolerance);
+}
+
+TEST(EvaluateTrajectory, OffsetAndRotatedEstimateHasZeroAte) {
+  const Trajectory gt = CurvedTrajectory(100);
+  const Eigen::Matrix3d rotation =
+      Eigen::AngleAxisd(1.2, Eigen::Vector3d(0.2, 0.3, 1).normalized()).toRotationMatrix();
+  const Trajectory est = Transform(gt, 1.0, rotation, Eigen::Vector3d(10, -4, 2));
+  const EvaluationResult result = EvaluateTrajectory(gt, est);
+  EXPECT_NEAR(result.scale, 1.0, kTolerance);
+  EXPECT_NEAR(result.ate_m, 0.0, kTolerance);
+  EXPECT_NEAR(result.rpe_cm_s, 0.0, kTolerance);
+  EXPECT_NEAR(result.rpe_deg_s, 0.0, kTolerance);
+  EXPECT_LT((result.gt_from_est.rotation - rotation.transpose()).norm(), kTolerance);
+}
+
+TEST(EvaluateTrajectory, KnownPerPoseNoiseGivesKnownAte) {
+  // est: the 8 corners (+-1, +-1, +-1) of a cube. gt = s R est + t + a xyz u: the noise a xyz u
+  // has zero mean and is orthogonal to every coordinate of the corners (sum x^2 y z = 0), so the
+  // Umeyama alignment is exactly (s, R, t) and every residual has norm |a xyz| = a.
+  const double a = 0.05, s = 3.0;
+  const Eigen::Vector3d u = Eigen::Vector3d(1, 2, -2) / 3.0;  // unit
+  const Eigen::Matrix3d rotation =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
+  const Eigen::Vector3d translation(1, 2, 3);
+  Trajectory est, gt;
+  int i = 0;
+  for (int x : {-1, 1}) {
+    for (int y : {-1, 1}) {
+      for (int z : {-1, 1}) {
+        const Eigen::Vector3d p(x, y, z);
+        est.push_back(Pose(i, p));
+        gt.push_back(Pose(i, s * rotation * p + translation + a * x * y * z * u));
+        ++i;
+      }
+    }
+  }
+  const EvaluationResult result = EvaluateTrajectory(gt, est);
+  EXPECT_NEAR(result.scale, s, kTolerance);
+  EXPECT_NEAR(result.ate_m, a, kTolerance);
+  EXPECT_EQ(result.num_associated, 8);
+}
+
+TEST(EvaluateTrajectory, RpeOfConstantVelocityWithKnownHeadingDrift) {
+  // gt: 1 m/s along x for 10 s at 10 Hz, camera orientation identity. est: the same positions
+  // at half scale, but the camera yawed by a constant theta, so every relative motion is seen
+  // rotated: the relative translation over 1 s, scaled back by s = 2, is Rz(-theta) (1, 0, 0) and
+  // differs from gt's (1, 0, 0) by 2 sin(theta / 2) m; the relative rotations agree (0 deg/s).
+  const double theta = 2.0 * std::asin(0.05);  // 2 sin(theta/2) = 0.1 m per 1 s = 10 cm/s
+  const Eigen::Quaterniond yaw(Eigen::AngleAxisd(theta, Eigen::Vector3d::UnitZ()));
+  Trajectory gt, est;
+  for (int i = 0; i <= 100; ++i) {
+    const double t = 0.1 * i;
+    gt.push_back(Pose(t, Eigen::Vector3d(t, 0, 0)));
+    est.push_back(Pose(t, Eigen::Vector3d(0.5 * t, 0, 0), yaw));
+  }
+  const EvaluationResult result = EvaluateTrajectory(gt, est);
+  EXPECT_NEAR(result.scale, 2.0, kTolerance);
+  EXPECT_NEAR(result.ate_m, 0.0, kTolerance);
+  EXPECT_NEAR(result.rpe_cm_s, 10.0, 1e-7);
+  EXPECT_NEAR(result.rpe_deg_s, 0.0, 1e-7);
+  // Pairs (i, i + 10) for i = 0..90.
+  EXPECT_EQ(result.num_pairs, 91);
+}
+
+TEST(EvaluateTrajectory, RpeOfConstantRotationalDrift) {
+  // Positions identical, the estimate's camera turning at 2 deg/s about z more than gt's: the
+  // rotational RPE is 2 deg/s for every pair.
+  const double rate = 2.0 * M_PI / 180.0;
+  Trajectory gt, est;
+  for (int i = 0; i <= 50; ++i) {
+    const double t = 0.1 * i;
+    const Eigen::Vector3d p(std::cos(t), std::sin(t), 0.1 * t * t);
+    gt.push_back(Pose(t, p));
+    est.push_back(
+        Pose(t, p, Eigen::Quaterniond(Eigen::AngleAxisd(rate * t, Eigen::Vector3d::UnitZ()))));
+  }
+  const EvaluationResult result = EvaluateTrajectory(gt, est);
+  EXPECT_NEAR(result.rpe_deg_s, 2.0, 1e-7);
+  EXPECT_NEAR(result.ate_m, 0.0, kTolerance);
+}
+
+TEST(EvaluateTrajectory, CoverageCountsDroppedFrames) {
+  // 100 gt poses at 10 Hz; the estimate loses 20 frames in the middle (tracking failure): 80
+  // associated poses of 0.1 s over a 9.9 + 0.1 s span, coverage 0.8. The remaining poses are
+  // exact, so ATE stays 0: coverage is what reports the loss.
+  const Trajectory gt = CurvedTrajectory(100);
+  Trajectory est;
+  for (int i = 0; i < 100; ++i) {
+    if (i < 40 || i >= 60) est.push_back(gt[i]);
+  }
+  const EvaluationResult result = EvaluateTrajectory(gt, est);
+  EXPECT_EQ(result.num_associated, 80);
+  EXPECT_NEAR(result.coverage, 0.8, kTolerance);
+  EXPECT_NEAR(result.ate_m, 0.0, kTolerance);
+
+  // Lost after 25 frames and never recovered: coverage 0.25.
+  const Trajectory short_est(gt.begin(), gt.begin() + 25);
+  EXPECT_NEAR(EvaluateTrajectory(gt, short_est).coverage, 0.25, kTolerance);
+}
+
+TEST(EvaluateTrajectory, AssociationRespectsMaxTimeDifference) {
+  // Estimate stamps offset by 0.015 s (associated) and 0.03 s (not, > 0.02 s).
+  const Trajectory gt = CurvedTrajectory(30);
+  Trajectory est;
+  for (int i = 0; i < 30; ++i) {
+    StampedPose pose = gt[i];
+    pose.timestamp += (i % 2 == 0) ? 0.015 : 0.03;
+    est.push_back(pose);
+  }
+  const EvaluationResult result = EvaluateTrajectory(gt, est);
+  EXPECT_EQ(result.num_associated, 15);
+  EXPECT_NEAR(result.ate_m, 0.0, kTolerance);
+}
+
+TEST(EvaluateTrajectory, TooFewAssociatedPosesThrow) {
+  const Trajectory gt = CurvedTrajectory(30);
+  Trajectory est = {Pose(100.0, {0, 0, 0}), Pose(101.0, {1, 0, 0}), Pose(102.0, {0, 1, 0})};
+  EXPECT_THROW(EvaluateTrajectory(gt, est), std::invalid_argument);
+}
+
+TEST(EvaluateTrajectory, ShortEstimateHasNoRpePairs) {
+  const Trajectory gt = CurvedTrajectory(8);  // 0.7 s < rpe_delta
+  const EvaluationResult result = EvaluateTrajectory(gt, gt);
+  EXPECT_EQ(result.num_pairs, 0);
+  EXPECT_TRUE(std::isnan(result.rpe_cm_s));
+}
+
+}  // namespace
+}  // namespace pldvo

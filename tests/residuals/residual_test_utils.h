@@ -1,0 +1,109 @@
+// Synthetic scenes shared by the residual tests: a smooth analytic image sampled into an
+// ImagePyramid, a camera, a generic pose and reference pixels placed so that they reproject to
+// chosen current-frame positions.
+#ifndef PLDVO_TESTS_RESIDUALS_RESIDUAL_TEST_UTILS_H_
+#define PLDVO_TESTS_RESIDUALS_RESIDUAL_TEST_UTILS_H_
+
+#include <ceres/jet.h>
+
+#include <Eigen/Core>
+#include <cmath>
+#include <opencv2/core.hpp>
+#include <random>
+
+#include "core/image_pyramid.h"
+#include "core/pinhole_camera.h"
+#include "core/se3.h"
+
+namespace pldvo {
+namespace testing_utils {
+
+inline PinholeCamera TestCamera() {
+  PinholeCamera camera;
+  camera.width = 160;
+  camera.height = 120;
+  camera.fx = 140.0;
+  camera.fy = 135.0;
+  camera.cx = 79.5;
+  camera.cy = 59.5;
+  return camera;
+}
+
+// A smooth texture: wavelengths 29..53 px, gradients of about 10 gray levels per pixel.
+inline double SmoothIntensity(double x, double y) {
+  constexpr double kTwoPi = 6.283185307179586;
+  return 128.0 + 50.0 * std::sin(kTwoPi * x / 37.0 + 0.3) * std::cos(kTwoPi * y / 29.0 - 0.2) +
+         30.0 * std::sin(kTwoPi * (x + 2.0 * y) / 53.0);
+}
+
+// A linear ramp: bilinear interpolation and central differences are exact on it, so the
+// analytic Jacobian equals the derivative of the interpolated residual exactly.
+inline double RampIntensity(double x, double y) { return 40.0 + 0.9 * x + 0.6 * y; }
+
+template <typename Function>
+cv::Mat SampleImage(const PinholeCamera& camera, Function function) {
+  cv::Mat image(camera.height, camera.width, CV_32F);
+  for (int y = 0; y < camera.height; ++y) {
+    for (int x = 0; x < camera.width; ++x) {
+      image.at<float>(y, x) = static_cast<float>(function(x, y));
+    }
+  }
+  return image;
+}
+
+// A generic pose cur_from_ref: 0.06 rad about a skew axis, 12 cm translation.
+inline SE3 TestCurFromRef() {
+  Vector6d twist;
+  twist << 0.09, -0.05, 0.06, 0.03, -0.04, 0.025;
+  return SE3::Exp(twist);
+}
+
+// A reference pixel and its inverse depth that reproject (with cur_from_ref) to pixel_in_cur
+// at depth `depth_in_cur` in the current frame.
+inline void PlaceReferencePixel(const PinholeCamera& camera, const SE3& cur_from_ref,
+                                const Eigen::Vector2d& pixel_in_cur, double depth_in_cur,
+                                Eigen::Vector2d* pixel_in_ref, double* idepth) {
+  const Eigen::Vector3d point_in_cur = depth_in_cur * camera.Unproject(pixel_in_cur);
+  const Eigen::Vector3d point_in_ref = cur_from_ref.Inverse() * point_in_cur;
+  *pixel_in_ref = camera.Project(point_in_ref);
+  *idepth = 1.0 / point_in_ref.z();
+}
+
+// Jet-aware intensity sampler for autodiff twins: the value is the bilinear intensity and the
+// derivative is the bilinearly interpolated precomputed gradient, i.e. exactly the model of the
+// analytic Jacobians.
+inline double SampleIntensity(const ImagePyramid& pyramid, int level, double u, double v) {
+  return pyramid.Sample(level, u, v)[0];
+}
+template <typename T, int N>
+ceres::Jet<T, N> SampleIntensity(const ImagePyramid& pyramid, int level, const ceres::Jet<T, N>& u,
+                                 const ceres::Jet<T, N>& v) {
+  const Eigen::Vector3f sample = pyramid.Sample(level, u.a, v.a);
+  ceres::Jet<T, N> result;
+  result.a = static_cast<double>(sample[0]);
+  result.v = static_cast<double>(sample[1]) * u.v + static_cast<double>(sample[2]) * v.v;
+  return result;
+}
+
+// Templated twins of the row-wise square-root robustification (residuals/robustify.h) for
+// Ceres' HuberLoss(a) and CauchyLoss(a).
+template <typename T>
+T HuberSqrtForm(const T& r, double a) {
+  using std::sqrt;
+  const T s = r * r;
+  const T rho = s <= T(a * a) ? s : T(2.0 * a) * sqrt(s) - T(a * a);
+  return r >= T(0.0) ? sqrt(rho) : -sqrt(rho);
+}
+template <typename T>
+T CauchySqrtForm(const T& r, double a) {
+  using std::log;
+  using std::sqrt;
+  const double b = a * a;
+  const T rho = T(b) * log(T(1.0) + r * r / T(b));
+  return r >= T(0.0) ? sqrt(rho) : -sqrt(rho);
+}
+
+}  // namespace testing_utils
+}  // namespace pldvo
+
+#endif  // PLDVO_TESTS_RESIDUALS_RESIDUAL_TEST_UTILS_H_
