@@ -181,7 +181,10 @@ void WriteCameraYaml(const CameraModel& camera, const std::string& path) {
       std::snprintf(buffer, sizeof(buffer), "%.*g", precision, value);
       if (std::strtod(buffer, nullptr) == value) break;
     }
-    return std::string(buffer);
+    // A real-looking spelling: cv::FileStorage reads "19444444444444444" as an int and wraps it.
+    std::string text = buffer;
+    if (text.find_first_of(".eE") == std::string::npos) text += ".0";
+    return text;
   };
   file << "%YAML:1.0\n---\n"
        << "# pldvo camera calibration (docs/cameras.md). Pixel (0, 0) is the centre of the\n"

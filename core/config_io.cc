@@ -227,6 +227,10 @@ std::string SetFromText(const ConfigEntry& entry, const std::string& text) {
       return ParseDouble(text, value) ? "" : "expected a number, got '" + text + "'";
     }
     std::string operator()(std::string* value) const {
+      // cv::FileStorage reads no control character back (WriteConfigYaml must round-trip).
+      for (char c : text) {
+        if (static_cast<unsigned char>(c) < 0x20) return "control characters are not allowed";
+      }
       *value = text;
       return "";
     }
@@ -362,6 +366,39 @@ void WriteComment(const std::string& doc, const std::string& indent, std::ostrin
   while (std::getline(lines, line)) *out << indent << "# " << line << "\n";
 }
 
+// cv::FileStorage (OpenCV 4.6 persistence_yml.cpp, YAMLParser::parse) loops forever when a
+// second YAML document starts with '-' other than "---" ("a: 1\n...\n- 1"), which an indented
+// root map ended by a line at column 0 also reaches ("  a: 1\nb\n-"). Our files are one map,
+// so reject what leads to a second document: a second "---", a "...", keys on the "---" line,
+// and an indented first key. Found by tests/fuzz/camera_yaml_fuzzer (docs/reliability.md).
+void RejectMultipleDocuments(const std::string& text, const std::string& path) {
+  std::istringstream lines(text);
+  std::string line;
+  int line_number = 0;
+  bool seen_marker = false, seen_content = false;
+  auto fail = [&](const std::string& what) {
+    throw std::runtime_error(path + ":" + std::to_string(line_number) + ": " + what);
+  };
+  while (std::getline(lines, line)) {
+    ++line_number;
+    const size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    if (!seen_content && !seen_marker && line[0] == '%') continue;  // a directive
+    if (line.compare(0, 3, "---") == 0) {
+      if (seen_marker || seen_content) fail("only one YAML document is supported (second '---')");
+      const size_t rest = line.find_first_not_of(" \t\r", 3);
+      if (rest != std::string::npos && (rest == 3 || line[rest] != '#')) {
+        fail("put the keys on the lines after '---'");
+      }
+      seen_marker = true;
+      continue;
+    }
+    if (line.compare(0, 3, "...") == 0) fail("the document end marker '...' is not supported");
+    if (!seen_content && first != 0) fail("the top-level keys must start at column 0");
+    seen_content = true;
+  }
+}
+
 }  // namespace
 
 void OpenYamlForReading(const std::string& path, cv::FileStorage* storage) {
@@ -370,6 +407,7 @@ void OpenYamlForReading(const std::string& path, cv::FileStorage* storage) {
   std::ostringstream content;
   content << file.rdbuf();
   std::string text = content.str();
+  RejectMultipleDocuments(text, path);
   // cv::FileStorage needs the "%YAML" directive to recognise YAML in memory; add it if missing.
   int added_lines = 0;
   if (text.compare(0, 5, "%YAML") != 0) {

@@ -49,6 +49,8 @@ std::vector<TableLine> ReadTable(const std::string& path, bool commas) {
     std::istringstream fields(line);
     std::string field;
     while (fields >> field) entry.fields.push_back(field);
+    // Blank by operator>>'s whitespace (e.g. only '\v' or '\f'): no fields for readers to index.
+    if (entry.fields.empty()) continue;
     table.push_back(std::move(entry));
   }
   return table;
@@ -181,6 +183,17 @@ cv::Mat Rectifier::Rectify(const cv::Mat& gray8) const {
   cv::Mat gray32;
   gray8.convertTo(gray32, CV_32F);
   return undistorter_->Undistort(gray32);
+}
+
+Frame ImageListDataset::Load(int i) const {
+  Frame frame;
+  frame.index = i;
+  frame.timestamp = timestamps_.at(i);
+  frame.path = paths_[i];
+  const cv::Mat raw = ReadGray8(frame.path);
+  RequireSize(raw, rectifier_->input().width, rectifier_->input().height, frame.path);
+  frame.image = rectifier_->Rectify(raw);
+  return frame;
 }
 
 }  // namespace dataset_util

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/camera_model.h"
+#include "core/dataset.h"
 #include "core/pinhole_camera.h"
 
 namespace pldvo {
@@ -75,6 +76,28 @@ class Rectifier {
  private:
   std::unique_ptr<CameraModel> model_;
   std::unique_ptr<Undistorter> undistorter_;
+};
+
+// The plumbing of a reader whose frames are a list of timestamped image files under one
+// Rectifier: the derived constructor fills timestamps_, paths_ (same length), rectifier_ and,
+// when there is one, ground_truth_ with has_ground_truth_ = true. Load(i) reads paths_[i] as
+// 8-bit gray, checks the rectifier's input size and rectifies it.
+class ImageListDataset : public Dataset {
+ public:
+  int size() const override { return static_cast<int>(timestamps_.size()); }
+  double timestamp(int i) const override { return timestamps_.at(i); }
+  const PinholeCamera& camera() const override { return rectifier_->output(); }
+  const Trajectory* ground_truth() const override {
+    return has_ground_truth_ ? &ground_truth_ : nullptr;
+  }
+  Frame Load(int i) const override;
+
+ protected:
+  std::vector<double> timestamps_;
+  std::vector<std::string> paths_;
+  std::unique_ptr<Rectifier> rectifier_;
+  Trajectory ground_truth_;
+  bool has_ground_truth_ = false;
 };
 
 }  // namespace dataset_util

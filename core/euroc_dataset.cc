@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -116,6 +117,12 @@ EurocCamera ReadEurocCamera(const std::string& path) {
   if (projection.text != "pinhole") {
     FailAt(path, projection.line_number, "unsupported camera_model '" + projection.text + "'");
   }
+  for (double side : resolution) {  // casting a double beyond int's range is undefined
+    if (!(side >= 1.0 && side <= std::numeric_limits<int>::max()) || side != std::floor(side)) {
+      FailAt(path, Require(values, "resolution", path).line_number,
+             "resolution must be two positive integers");
+    }
+  }
   PinholeCamera pinhole;
   pinhole.width = static_cast<int>(resolution[0]);
   pinhole.height = static_cast<int>(resolution[1]);
@@ -170,7 +177,7 @@ Trajectory ReadEurocGroundTruth(const std::string& path, const SE3& body_from_ca
   return trajectory;
 }
 
-class EurocDataset : public Dataset {
+class EurocDataset : public ImageListDataset {
  public:
   EurocDataset(const std::string& dir, const DatasetOptions& options) {
     const std::string mav0 = IsDirectory(JoinPath(dir, "mav0")) ? JoinPath(dir, "mav0") : dir;
@@ -211,30 +218,6 @@ class EurocDataset : public Dataset {
   }
 
   std::string format() const override { return "euroc"; }
-  int size() const override { return static_cast<int>(timestamps_.size()); }
-  double timestamp(int i) const override { return timestamps_.at(i); }
-  const PinholeCamera& camera() const override { return rectifier_->output(); }
-  const Trajectory* ground_truth() const override {
-    return has_ground_truth_ ? &ground_truth_ : nullptr;
-  }
-
-  Frame Load(int i) const override {
-    Frame frame;
-    frame.index = i;
-    frame.timestamp = timestamps_.at(i);
-    frame.path = paths_[i];
-    const cv::Mat raw = ReadGray8(frame.path);
-    RequireSize(raw, rectifier_->input().width, rectifier_->input().height, frame.path);
-    frame.image = rectifier_->Rectify(raw);
-    return frame;
-  }
-
- private:
-  std::unique_ptr<Rectifier> rectifier_;
-  std::vector<double> timestamps_;
-  std::vector<std::string> paths_;
-  Trajectory ground_truth_;
-  bool has_ground_truth_ = false;
 };
 
 }  // namespace

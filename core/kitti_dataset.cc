@@ -84,7 +84,7 @@ std::string FindPoses(const std::string& dir) {
   return "";
 }
 
-class KittiDataset : public Dataset {
+class KittiDataset : public ImageListDataset {
  public:
   KittiDataset(const std::string& dir, const DatasetOptions& options) {
     const std::string times = JoinPath(dir, "times.txt");
@@ -125,30 +125,6 @@ class KittiDataset : public Dataset {
   }
 
   std::string format() const override { return "kitti"; }
-  int size() const override { return static_cast<int>(timestamps_.size()); }
-  double timestamp(int i) const override { return timestamps_.at(i); }
-  const PinholeCamera& camera() const override { return rectifier_->output(); }
-  const Trajectory* ground_truth() const override {
-    return has_ground_truth_ ? &ground_truth_ : nullptr;
-  }
-
-  Frame Load(int i) const override {
-    Frame frame;
-    frame.index = i;
-    frame.timestamp = timestamps_.at(i);
-    frame.path = paths_[i];
-    const cv::Mat raw = ReadGray8(frame.path);
-    RequireSize(raw, rectifier_->input().width, rectifier_->input().height, frame.path);
-    frame.image = rectifier_->Rectify(raw);
-    return frame;
-  }
-
- private:
-  std::vector<double> timestamps_;
-  std::vector<std::string> paths_;
-  std::unique_ptr<Rectifier> rectifier_;
-  Trajectory ground_truth_;
-  bool has_ground_truth_ = false;
 };
 
 }  // namespace

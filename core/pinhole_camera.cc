@@ -35,8 +35,17 @@ PinholeCamera PinholeCamera::AtLevel(int level) const {
 
 std::string PinholeCamera::Check() const {
   std::ostringstream error;
-  if (width <= 0 || height <= 0) error << "image size must be positive, got " << width << "x"
-                                       << height << "; ";
+  if (width <= 0 || height <= 0)
+    error << "image size must be positive, got " << width << "x" << height << "; ";
+  // Bounds the undistortion maps and border scans a calibration file can request (a typo like
+  // "width: 6400000" would otherwise exhaust memory or hang); 8K UHD and 20 MP fit.
+  constexpr int kMaxSide = 32768;
+  constexpr long long kMaxPixels = 1LL << 25;
+  if (width > kMaxSide || height > kMaxSide ||
+      static_cast<long long>(width) * height > kMaxPixels) {
+    error << "image size " << width << "x" << height << " exceeds the supported " << kMaxSide
+          << " px per side and " << kMaxPixels << " pixels; ";
+  }
   if (!(fx > 0.0) || !(fy > 0.0) || !std::isfinite(fx) || !std::isfinite(fy)) {
     error << "focal lengths must be positive and finite, got fx=" << fx << " fy=" << fy << "; ";
   }

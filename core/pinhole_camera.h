@@ -37,7 +37,8 @@ struct PinholeCamera {
   // The camera of pyramid level `level` (each level halves the resolution by 2x2 averaging, so
   // the pixel-centre convention gives c' = (c + 0.5) / 2 - 0.5).
   PinholeCamera AtLevel(int level) const;
-  // Checks positive size and focal lengths; returns an empty string or what is wrong.
+  // Checks positive size (at most 32768 px a side and 2^25 pixels) and focal lengths; returns
+  // an empty string or what is wrong.
   std::string Check() const;
 };
 

@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 
+#include "residuals/batched_reprojection.h"
 #include "residuals/robustify.h"
 #include "residuals/se3_manifold.h"
 
@@ -115,25 +115,12 @@ void PointToLineResidual::EvaluateTangent(const SE3& cur_from_ref, double* resid
 
 std::vector<Eigen::Vector2d> PointToLineResidual::ReprojectedPixels(
     const SE3& cur_from_ref, std::vector<std::uint8_t>* valid) const {
-  std::vector<double> residuals(observations_.size());
-  std::vector<std::uint8_t> row_valid(observations_.size());
-  EvaluateTangent(cur_from_ref, residuals.data(), nullptr, row_valid.data());
-  const Eigen::Matrix3d rotation = cur_from_ref.rotation_matrix();
-  std::vector<Eigen::Vector2d> pixels(observations_.size());
-  for (size_t i = 0; i < observations_.size(); ++i) {
-    const Eigen::Vector3d q =
-        rotation * rays_in_ref_[i] + observations_[i].idepth * cur_from_ref.translation();
-    pixels[i] = q.z() > 0.0 ? camera_.Project(q)
-                            : Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
-  }
-  if (valid != nullptr) *valid = std::move(row_valid);
-  return pixels;
+  return ReprojectRays(camera_, rays_in_ref_, observations_, cur_from_ref, valid,
+                       [&](double* residuals, std::uint8_t* row_valid) {
+                         EvaluateTangent(cur_from_ref, residuals, nullptr, row_valid);
+                       });
 }
 
-int PointToLineResidual::num_valid() const {
-  int count = 0;
-  for (const std::uint8_t v : valid_) count += v;
-  return count;
-}
+int PointToLineResidual::num_valid() const { return CountValid(valid_); }
 
 }  // namespace pldvo

@@ -300,7 +300,7 @@ TEST(UndistorterTest, BlobLandsAtItsPinholeProjection) {
 TEST(UndistorterTest, OutputCameras) {
   // radtan keeps K.
   const auto radtan = Radtan();
-  const PinholeCamera& radtan_output = Undistorter(*radtan).output_camera();
+  const PinholeCamera radtan_output = Undistorter(*radtan).output_camera();
   EXPECT_EQ(radtan_output.fx, radtan->intrinsics().fx);
   EXPECT_EQ(radtan_output.fy, radtan->intrinsics().fy);
   EXPECT_EQ(radtan_output.cx, radtan->intrinsics().cx);

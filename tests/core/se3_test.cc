@@ -117,8 +117,7 @@ TEST(SE3, ComposeInverseAndActOnPoints) {
   const Eigen::Vector3d point_in_a(0.5, -0.25, 2.0);
   const Eigen::Vector3d point_in_b = b_from_a * point_in_a;
   EXPECT_LT((b_from_a.Inverse() * point_in_b - point_in_a).norm(), 1e-14);
-  EXPECT_LT(((b_from_a * b_from_a.Inverse()).matrix() - Eigen::Matrix4d::Identity()).norm(),
-            1e-14);
+  EXPECT_LT(((b_from_a * b_from_a.Inverse()).matrix() - Eigen::Matrix4d::Identity()).norm(), 1e-14);
   EXPECT_LT((b_from_a.matrix() * point_in_a.homogeneous() - point_in_b.homogeneous()).norm(),
             1e-14);
 }

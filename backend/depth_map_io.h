@@ -1,0 +1,36 @@
+// Output of a keyframe's semi-dense map (no GUI): the inverse-depth map as a colour PNG and the
+// semi-dense points as an ASCII PLY point cloud.
+#ifndef PLDVO_BACKEND_DEPTH_MAP_IO_H_
+#define PLDVO_BACKEND_DEPTH_MAP_IO_H_
+
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "backend/semi_dense_depth_map.h"
+#include "core/pinhole_camera.h"
+#include "core/se3.h"
+
+namespace pldvo {
+
+// The inverse-depth map as a BGR image: valid pixels coloured by cv::COLORMAP_JET over
+// [idepth_min, idepth_max] (red near, blue far), invalid pixels black. With idepth_min >=
+// idepth_max the range is the 2nd..98th percentile of the valid inverse depths.
+cv::Mat ColorizeInverseDepth(const SemiDenseDepthMap& map, double idepth_min = 0.0,
+                             double idepth_max = 0.0);
+// Writes ColorizeInverseDepth to a PNG; throws std::runtime_error naming the path on failure.
+void WriteInverseDepthPng(const SemiDenseDepthMap& map, const std::string& path,
+                          double idepth_min = 0.0, double idepth_max = 0.0);
+
+// Writes the valid hypotheses with idepth > 0 and at least one stereo observation (initial and
+// hole-filled guesses are left out) as an ASCII PLY ("x y z intensity" per vertex):
+// the point K^-1 (x; 1) / idepth mapped by world_from_cam, the intensity of `image` (8-bit or
+// float gray of the map's size) at the pixel. Returns the number of points written; throws
+// std::runtime_error naming the path when the file cannot be written and
+// std::invalid_argument on a size mismatch.
+int WritePointCloudPly(const SemiDenseDepthMap& map, const cv::Mat& image,
+                       const PinholeCamera& camera, const SE3& world_from_cam,
+                       const std::string& path);
+
+}  // namespace pldvo
+
+#endif  // PLDVO_BACKEND_DEPTH_MAP_IO_H_

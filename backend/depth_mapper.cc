@@ -1,0 +1,197 @@
+#include "backend/depth_mapper.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "backend/depth_regularizer.h"
+#include "backend/line_stereo.h"
+
+namespace pldvo {
+namespace {
+
+double ElapsedMs(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+}  // namespace
+
+DepthMapper::DepthMapper(const PinholeCamera& camera, const MappingOptions& options)
+    : camera_(camera), options_(options) {
+  const std::string camera_error = camera.Check();
+  if (!camera_error.empty()) throw std::invalid_argument("DepthMapper: camera: " + camera_error);
+  const std::string error = options.Check();
+  if (!error.empty()) throw std::invalid_argument("DepthMapper: " + error);
+}
+
+void DepthMapper::SetKeyframe(const cv::Mat& image, const EdgeTrace& edges) {
+  if (image.empty() || image.cols != camera_.width || image.rows != camera_.height ||
+      image.channels() != 1) {
+    throw std::invalid_argument("DepthMapper: keyframe must be a gray image of the camera's size");
+  }
+  if (!edges.id_map.empty() &&
+      (edges.id_map.cols != image.cols || edges.id_map.rows != image.rows)) {
+    throw std::invalid_argument("DepthMapper: edge id map size differs from the image");
+  }
+  keyframe_ = ImagePyramid(image, 1);
+  edges_ = edges;
+  map_ = SemiDenseDepthMap(image.cols, image.rows);
+  map_.SelectPixels(keyframe_, edges_.id_map, options_);
+  line_in_ref_by_id_.clear();
+  for (const TracedLine& line : edges_.lines) {
+    if (line.id < 0) continue;
+    if (line.id >= static_cast<int>(line_in_ref_by_id_.size())) {
+      line_in_ref_by_id_.resize(line.id + 1, Eigen::Vector3d::Zero());
+    }
+    line_in_ref_by_id_[line.id] = line.segment.line;
+  }
+}
+
+void DepthMapper::InitializeKeyframe(const cv::Mat& image, const EdgeTrace& edges) {
+  SetKeyframe(image, edges);
+  if (options_.init == MappingOptions::Init::kRandom) {
+    map_.InitializeRandom(options_.init_idepth_min, options_.init_idepth_max,
+                          options_.init_idepth_var, options_.init_seed, options_.validity_initial);
+  } else {
+    map_.InitializeConstant(options_.init_idepth, options_.init_idepth_var,
+                            options_.validity_initial);
+  }
+}
+
+void DepthMapper::InitializeKeyframeFromDepth(const cv::Mat& image, const EdgeTrace& edges,
+                                              const cv::Mat& depth, double idepth_var) {
+  SetKeyframe(image, edges);
+  map_.InitializeFromDepth(depth, idepth_var, options_.validity_initial);
+}
+
+void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
+                              const EpipolarGeometry& geometry,
+                              const std::vector<MatchedLine>& lines_in_cur,
+                              FrameUpdateStats* stats) {
+  const Eigen::Vector2d pixel(index % map_.width(), index / map_.width());
+  const bool valid = map_.valid(index);
+  double idepth_min = options_.min_idepth, idepth_max = options_.max_idepth;
+  double idepth_centre = options_.init_idepth;
+  if (valid) {
+    const double d = map_.idepth(index);
+    const double range = options_.search_sigmas * std::sqrt(map_.idepth_var(index));
+    idepth_min = std::max(options_.min_idepth, d - range);
+    idepth_max = std::min(options_.max_idepth, d + range);
+    idepth_centre = std::clamp(d, idepth_min, idepth_max);
+    if (idepth_max <= idepth_min) return;
+  }
+  EpipolarPatch patch;
+  const StereoStatus patch_status =
+      MakeEpipolarPatch(keyframe_, geometry, pixel, idepth_centre, options_, &patch);
+  StereoObservation observation;
+  StereoStatus status = StereoStatus::kBadGeometry;
+
+  const int edge = map_.edge_id(index);
+  const bool has_line = options_.use_line_stereo && edge >= 0 &&
+                        edge < static_cast<int>(lines_in_cur.size()) && lines_in_cur[edge].matched;
+  if (has_line) {
+    ++stats->line_attempts;
+    // The foot point of the pixel on l1 (the pixel itself when l1 is unknown).
+    Eigen::Vector2d edge_pixel = pixel;
+    if (edge < static_cast<int>(line_in_ref_by_id_.size())) {
+      const Eigen::Vector3d& l1 = line_in_ref_by_id_[edge];
+      edge_pixel -= (l1.x() * pixel.x() + l1.y() * pixel.y() + l1.z()) * l1.head<2>();
+    }
+    status = LineGuidedStereo(geometry, pixel, edge_pixel, lines_in_cur[edge].line_in_cur,
+                              idepth_min, idepth_max, options_, &current,
+                              patch_status == StereoStatus::kOk ? &patch : nullptr, &observation);
+    if (status == StereoStatus::kOk) {
+      ++stats->line_ok;
+    } else if (status == StereoStatus::kLineIllConditioned) {
+      ++stats->line_fallback;
+    } else {
+      ++stats->line_rejected;
+      stats->line_out_of_range += status == StereoStatus::kLineOutOfRange;
+      return;
+    }
+  }
+  if (status != StereoStatus::kOk) {
+    if (patch_status != StereoStatus::kOk) return;
+    ++stats->ssd_attempts;
+    status = SearchEpipolarSsd(current, geometry, patch, pixel, idepth_min, idepth_max, options_,
+                               &observation);
+    if (status == StereoStatus::kNotUnique || status == StereoStatus::kLargeError) {
+      map_.AddBlacklist(index);
+    }
+    if (status != StereoStatus::kOk) return;
+    ++stats->ssd_ok;
+  }
+  if (valid) {
+    if (map_.Fuse(index, observation.idepth, observation.idepth_var, options_)) {
+      ++stats->fused;
+    } else {
+      ++stats->outliers;
+    }
+  } else {
+    map_.Set(index, observation.idepth, observation.idepth_var, options_.validity_initial);
+    map_.CountObservation(index);
+    ++stats->created;
+  }
+}
+
+FrameUpdateStats DepthMapper::UpdateWithFrame(const cv::Mat& image, const SE3& cur_from_ref,
+                                              const std::vector<MatchedLine>& lines_in_cur) {
+  if (image.empty() || image.cols != map_.width() || image.rows != map_.height() ||
+      image.channels() != 1) {
+    throw std::invalid_argument(
+        "DepthMapper::UpdateWithFrame: frame must be a gray image of the keyframe's size");
+  }
+  FrameUpdateStats stats;
+  const ImagePyramid current(image, 1);
+  const EpipolarGeometry geometry(camera_, cur_from_ref);
+  if (!(cur_from_ref.translation().norm() > 0.0)) return stats;  // no baseline, no stereo
+  // Two passes (edge pixels, then the rest) so that each is timed on its own.
+  for (int pass = 0; pass < 2; ++pass) {
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < map_.num_pixels(); ++i) {
+      if (!map_.candidate(i) || (map_.edge_id(i) >= 0) != (pass == 0)) continue;
+      if (map_.blacklist(i) >= options_.blacklist_threshold) continue;
+      if (pass == 0) ++stats.num_edge_pixels;
+      UpdatePixel(i, current, geometry, lines_in_cur, &stats);
+    }
+    (pass == 0 ? stats.edge_stereo_ms : stats.other_stereo_ms) = ElapsedMs(start);
+  }
+  if (options_.regularize) {
+    stats.removed = RemoveIsolatedHypotheses(options_, &map_);
+    stats.filled = FillHoles(options_, &map_);
+  }
+  return stats;
+}
+
+SemiDenseDepthMap DepthMapper::RegularizedMap(bool smooth, bool line_regularize,
+                                              LineRegularizationStats* stats) const {
+  SemiDenseDepthMap result;
+  if (smooth) {
+    SmoothDepthMap(map_, options_, &result);
+  } else {
+    result = map_;
+  }
+  if (line_regularize && !edges_.lines.empty()) {
+    const LineRegularizer regularizer(options_);
+    const LineRegularizationStats line_stats = regularizer.Regularize(camera_, edges_, &result);
+    if (stats) *stats = line_stats;
+  }
+  return result;
+}
+
+PropagationStats DepthMapper::PropagateToNewKeyframe(const cv::Mat& image, const EdgeTrace& edges,
+                                                     const SE3& new_from_old) {
+  const SemiDenseDepthMap old_map =
+      RegularizedMap(options_.regularize, options_.line_regularization);
+  const ImagePyramid old_keyframe = keyframe_;
+  SetKeyframe(image, edges);
+  PropagationStats stats;
+  map_ = PropagateDepthMap(old_map, old_keyframe, keyframe_, edges_.id_map, camera_, new_from_old,
+                           options_, &stats);
+  return stats;
+}
+
+}  // namespace pldvo

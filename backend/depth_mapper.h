@@ -1,0 +1,111 @@
+// Semi-dense keyframe mapping with line-guided stereo (Yang & Scherer, ICRA 2017, Sec. V, on
+// Engel, Sturm, Cremers, ICCV 2013): the keyframe's inverse-depth filter is updated with every
+// tracked frame, regularised, and propagated to the next keyframe.
+//
+//   DepthMapper mapper(camera, options);
+//   mapper.InitializeKeyframe(image0, edges0);             // random / constant init
+//   for each tracked frame k:
+//     mapper.UpdateWithFrame(image_k, cur_from_ref_k, lines_k);  // stereo + EKF
+//   SemiDenseDepthMap map = mapper.RegularizedMap(true, true);   // for tracking / output
+//   mapper.PropagateToNewKeyframe(image_k, edges_k, new_from_old);
+//
+// UpdateWithFrame: every candidate pixel that is not blacklisted is matched against the frame
+// (edge pixels with a matched line: line-guided stereo, eqs. 8-10, for the pixel's foot point on
+// its keyframe line l1 (the ray of a traced pixel up to 1.5 px off l1 misses the 3D line; its
+// nearest edge point is the foot point), falling back to the SSD search when the epipolar line
+// and the edge are nearly parallel; all other pixels: the SSD search over
+// idepth +- 2 sigma) and the observation is fused by the EKF (SemiDenseDepthMap::Fuse); pixels
+// without a hypothesis are searched over [min_idepth, max_idepth] and initialised from the
+// observation. Then isolated hypotheses are removed and holes filled (depth_regularizer.h).
+// Smoothing and the 3D line regularisation act on a copy (RegularizedMap), never on the filter
+// state, so that they do not count the same data twice.
+#ifndef PLDVO_BACKEND_DEPTH_MAPPER_H_
+#define PLDVO_BACKEND_DEPTH_MAPPER_H_
+
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "backend/depth_propagation.h"
+#include "backend/epipolar_stereo.h"
+#include "backend/line_regularizer.h"
+#include "backend/mapping_options.h"
+#include "backend/semi_dense_depth_map.h"
+#include "backend/tracking_reference.h"
+#include "core/image_pyramid.h"
+#include "core/pinhole_camera.h"
+#include "core/se3.h"
+#include "frontend/edge_tracer.h"
+
+namespace pldvo {
+
+struct FrameUpdateStats {
+  int line_attempts = 0;      // edge pixels with a matched line
+  int line_ok = 0;            // fused or created from the line-guided match
+  int line_fallback = 0;      // near-parallel: fell back to the SSD search
+  int line_rejected = 0;      // out of the prior interval or failed the SSD check
+  int line_out_of_range = 0;  // of which: outside the prior interval idepth +- 2 sigma
+  int ssd_attempts = 0;
+  int ssd_ok = 0;
+  int fused = 0;                 // EKF updates
+  int created = 0;               // new hypotheses from a full-range search
+  int outliers = 0;              // observations rejected by the EKF gate
+  int removed = 0;               // isolated hypotheses removed
+  int filled = 0;                // holes filled
+  int num_edge_pixels = 0;       // candidates on an edge that were processed
+  double edge_stereo_ms = 0.0;   // wall time of the stereo on edge pixels
+  double other_stereo_ms = 0.0;  // wall time of the stereo on all other pixels
+};
+
+class DepthMapper {
+ public:
+  // Throws std::invalid_argument when the camera or options are invalid.
+  DepthMapper(const PinholeCamera& camera, const MappingOptions& options);
+
+  // A first keyframe (8-bit or float gray image of the camera's size) initialised as
+  // options.init says; `edges` is its traced edges (may be empty). Throws on size mismatch.
+  void InitializeKeyframe(const cv::Mat& image, const EdgeTrace& edges);
+  // A keyframe whose hypotheses come from a z-depth image (CV_32F metres) with variance
+  // idepth_var (tests).
+  void InitializeKeyframeFromDepth(const cv::Mat& image, const EdgeTrace& edges,
+                                   const cv::Mat& depth, double idepth_var);
+
+  // Stereo with a tracked frame and fusion. lines_in_cur[e] is the current line matched to the
+  // keyframe edge e (the id in the keyframe's EdgeTrace); missing or unmatched entries use the
+  // SSD search.
+  FrameUpdateStats UpdateWithFrame(const cv::Mat& image, const SE3& cur_from_ref,
+                                   const std::vector<MatchedLine>& lines_in_cur);
+
+  // A copy of the filter state with inverse-variance smoothing (if smooth) and the 3D line
+  // regularisation of the keyframe's edges (if line_regularize).
+  SemiDenseDepthMap RegularizedMap(bool smooth, bool line_regularize,
+                                   LineRegularizationStats* stats = nullptr) const;
+
+  // Makes `image` the keyframe with the propagated RegularizedMap(options.regularize,
+  // options.line_regularization); new_from_old maps the old keyframe into the new one.
+  PropagationStats PropagateToNewKeyframe(const cv::Mat& image, const EdgeTrace& edges,
+                                          const SE3& new_from_old);
+
+  const SemiDenseDepthMap& depth_map() const { return map_; }
+  const ImagePyramid& keyframe() const { return keyframe_; }
+  const EdgeTrace& edges() const { return edges_; }
+  const PinholeCamera& camera() const { return camera_; }
+  const MappingOptions& options() const { return options_; }
+
+ private:
+  void SetKeyframe(const cv::Mat& image, const EdgeTrace& edges);
+  // Stereo + fusion of one candidate pixel.
+  void UpdatePixel(int index, const ImagePyramid& current, const EpipolarGeometry& geometry,
+                   const std::vector<MatchedLine>& lines_in_cur, FrameUpdateStats* stats);
+
+  PinholeCamera camera_;
+  MappingOptions options_;
+  ImagePyramid keyframe_;
+  EdgeTrace edges_;
+  SemiDenseDepthMap map_;
+  // l1 of every edge id (a^2 + b^2 = 1); zero for ids the trace does not hold.
+  std::vector<Eigen::Vector3d> line_in_ref_by_id_;
+};
+
+}  // namespace pldvo
+
+#endif  // PLDVO_BACKEND_DEPTH_MAPPER_H_

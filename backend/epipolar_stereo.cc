@@ -1,0 +1,226 @@
+#include "backend/epipolar_stereo.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace pldvo {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kMinZ = 1e-6;
+
+}  // namespace
+
+EpipolarGeometry::EpipolarGeometry(const PinholeCamera& camera, const SE3& cur_from_ref)
+    : camera_(camera), cur_from_ref_(cur_from_ref) {
+  const Eigen::Matrix3d k = camera.K();
+  krki_ = k * cur_from_ref.rotation_matrix() * k.inverse();
+  kt_ = k * cur_from_ref.translation();
+  const Eigen::Vector3d centre_in_ref =
+      -(cur_from_ref.rotation_matrix().transpose() * cur_from_ref.translation());
+  epipole_in_ref_h_ = k * centre_in_ref;
+}
+
+bool EpipolarGeometry::Project(const Eigen::Vector2d& pixel_in_ref, double idepth,
+                               Eigen::Vector2d* pixel_in_cur) const {
+  const Eigen::Vector3d q = InfinityPoint(pixel_in_ref) + idepth * kt_;
+  if (q.z() <= kMinZ * (1.0 + std::abs(idepth))) return false;
+  *pixel_in_cur = q.head<2>() / q.z();
+  return true;
+}
+
+Eigen::Vector2d EpipolarGeometry::IdepthJacobian(const Eigen::Vector2d& pixel_in_ref,
+                                                 double idepth) const {
+  const Eigen::Vector3d q = InfinityPoint(pixel_in_ref) + idepth * kt_;
+  return (kt_.head<2>() * q.z() - q.head<2>() * kt_.z()) / (q.z() * q.z());
+}
+
+double EpipolarGeometry::IdepthFromCurPixel(const Eigen::Vector2d& pixel_in_ref,
+                                            const Eigen::Vector2d& pixel_in_cur,
+                                            const Eigen::Vector2d& direction_in_cur) const {
+  // u = (A_x + d B_x) / (A_z + d B_z)  =>  d = (A_x - u A_z) / (u B_z - B_x), likewise in y.
+  const Eigen::Vector3d a = InfinityPoint(pixel_in_ref);
+  const int c = std::abs(direction_in_cur.x()) >= std::abs(direction_in_cur.y()) ? 0 : 1;
+  const double p = pixel_in_cur[c];
+  return (a[c] - p * a.z()) / (p * kt_.z() - kt_[c]);
+}
+
+bool EpipolarGeometry::EpipolarDirectionInRef(const Eigen::Vector2d& pixel_in_ref,
+                                              Eigen::Vector2d* dir) const {
+  // The line through x and the epipole e = (K c); e may be at infinity (c_z = 0).
+  const Eigen::Vector2d d = epipole_in_ref_h_.head<2>() - pixel_in_ref * epipole_in_ref_h_.z();
+  const double norm = d.norm();
+  if (!(norm > 1e-9 * (1.0 + epipole_in_ref_h_.norm()))) return false;
+  *dir = d / norm;
+  return true;
+}
+
+const char* StereoStatusName(StereoStatus status) {
+  switch (status) {
+    case StereoStatus::kOk:
+      return "ok";
+    case StereoStatus::kOutside:
+      return "outside";
+    case StereoStatus::kBadGeometry:
+      return "bad_geometry";
+    case StereoStatus::kSearchTooLong:
+      return "search_too_long";
+    case StereoStatus::kNotUnique:
+      return "not_unique";
+    case StereoStatus::kLargeError:
+      return "large_error";
+    case StereoStatus::kLineIllConditioned:
+      return "line_ill_conditioned";
+    case StereoStatus::kLineOutOfRange:
+      return "line_out_of_range";
+  }
+  return "unknown";
+}
+
+StereoStatus MakeEpipolarPatch(const ImagePyramid& keyframe, const EpipolarGeometry& geometry,
+                               const Eigen::Vector2d& pixel_in_ref, double idepth_centre,
+                               const MappingOptions& options, EpipolarPatch* patch) {
+  Eigen::Vector2d dir;
+  if (!geometry.EpipolarDirectionInRef(pixel_in_ref, &dir)) return StereoStatus::kBadGeometry;
+  const Eigen::Vector2d lo = pixel_in_ref - 2.0 * dir, hi = pixel_in_ref + 2.0 * dir;
+  if (!keyframe.CanSample(0, lo.x(), lo.y()) || !keyframe.CanSample(0, hi.x(), hi.y()) ||
+      !keyframe.CanSample(0, pixel_in_ref.x(), pixel_in_ref.y())) {
+    return StereoStatus::kOutside;
+  }
+  const Eigen::Vector3f centre = keyframe.Sample(0, pixel_in_ref.x(), pixel_in_ref.y());
+  const double grad_norm = std::hypot(centre.y(), centre.z());
+  if (!(grad_norm > 0.0)) return StereoStatus::kBadGeometry;
+  patch->gradient_epipolar_cos = std::abs(centre.y() * dir.x() + centre.z() * dir.y()) / grad_norm;
+  if (patch->gradient_epipolar_cos < options.min_gradient_epipolar_cos) {
+    return StereoStatus::kBadGeometry;
+  }
+  for (int j = -2; j <= 2; ++j) {
+    const Eigen::Vector2d p = pixel_in_ref + j * dir;
+    patch->ref[j + 2] = keyframe.Sample(0, p.x(), p.y())[0];
+  }
+  Eigen::Vector2d p0, p1;
+  if (!geometry.Project(pixel_in_ref, idepth_centre, &p0) ||
+      !geometry.Project(pixel_in_ref + dir, idepth_centre, &p1)) {
+    return StereoStatus::kOutside;
+  }
+  const Eigen::Vector2d step = p1 - p0;
+  const double scale = step.norm();
+  if (!(scale <= options.max_epipolar_scale && scale >= 1.0 / options.max_epipolar_scale)) {
+    return StereoStatus::kBadGeometry;
+  }
+  patch->dir_ref = dir;
+  patch->step_cur = step;
+  return StereoStatus::kOk;
+}
+
+double PatchSsd(const ImagePyramid& current, const EpipolarPatch& patch,
+                const Eigen::Vector2d& pixel_in_cur) {
+  const Eigen::Vector2d lo = pixel_in_cur - 2.0 * patch.step_cur;
+  const Eigen::Vector2d hi = pixel_in_cur + 2.0 * patch.step_cur;
+  if (!current.CanSample(0, lo.x(), lo.y()) || !current.CanSample(0, hi.x(), hi.y())) return kInf;
+  double ssd = 0.0;
+  for (int j = -2; j <= 2; ++j) {
+    const Eigen::Vector2d p = pixel_in_cur + j * patch.step_cur;
+    const double r = current.Sample(0, p.x(), p.y())[0] - patch.ref[j + 2];
+    ssd += r * r;
+  }
+  return ssd;
+}
+
+double GeometricDisparityVar(const EpipolarPatch& patch, double sigma_epipolar_px) {
+  const double c = std::max(patch.gradient_epipolar_cos, 1e-6);
+  return sigma_epipolar_px * sigma_epipolar_px / (c * c);
+}
+
+double PhotometricDisparityVar(const ImagePyramid& current, const EpipolarPatch& patch,
+                               const Eigen::Vector2d& pixel_in_cur, double sigma_intensity) {
+  // g_p^2: mean squared finite difference of the five current samples per current pixel.
+  double samples[5];
+  for (int j = -2; j <= 2; ++j) {
+    const Eigen::Vector2d p = pixel_in_cur + j * patch.step_cur;
+    if (!current.CanSample(0, p.x(), p.y())) return kInf;
+    samples[j + 2] = current.Sample(0, p.x(), p.y())[0];
+  }
+  const double step_sq = patch.step_cur.squaredNorm();
+  double grad_sq = 0.0;
+  for (int j = 0; j < 4; ++j)
+    grad_sq += (samples[j + 1] - samples[j]) * (samples[j + 1] - samples[j]);
+  grad_sq /= 4.0 * step_sq;
+  return 2.0 * sigma_intensity * sigma_intensity / std::max(grad_sq, 1e-9);
+}
+
+StereoStatus SearchEpipolarSsd(const ImagePyramid& current, const EpipolarGeometry& geometry,
+                               const EpipolarPatch& patch, const Eigen::Vector2d& pixel_in_ref,
+                               double idepth_min, double idepth_max, const MappingOptions& options,
+                               StereoObservation* observation) {
+  Eigen::Vector2d p_far, p_near;
+  if (!geometry.Project(pixel_in_ref, idepth_min, &p_far)) return StereoStatus::kOutside;
+  if (!geometry.Project(pixel_in_ref, idepth_max, &p_near)) {
+    // The upper bound lies behind the current camera: search up to just before its plane.
+    const Eigen::Vector3d a = geometry.InfinityPoint(pixel_in_ref);
+    const Eigen::Vector3d& b = geometry.ScaledTranslation();
+    if (!(b.z() < 0.0)) return StereoStatus::kOutside;
+    const double d_plane = -a.z() / b.z();  // q_z = 0
+    idepth_max = idepth_min + 0.9 * (d_plane - idepth_min);
+    if (!geometry.Project(pixel_in_ref, idepth_max, &p_near)) return StereoStatus::kOutside;
+  }
+  Eigen::Vector2d direction = p_near - p_far;
+  double length = direction.norm();
+  if (length > options.max_search_length_px) return StereoStatus::kSearchTooLong;
+  if (length > 1e-9) {
+    direction /= length;
+  } else {
+    direction = patch.step_cur.normalized();
+  }
+  Eigen::Vector2d start = p_far;
+  if (length < options.min_search_length_px) {
+    start = 0.5 * (p_far + p_near) - 0.5 * options.min_search_length_px * direction;
+    length = options.min_search_length_px;
+  }
+  const int num_steps = static_cast<int>(std::floor(length)) + 1;
+  // The SSD at every 1-px step; small fixed buffer (max_search_length_px bounds it).
+  constexpr int kMaxSteps = 4096;
+  if (num_steps > kMaxSteps) return StereoStatus::kSearchTooLong;
+  double ssd[kMaxSteps];
+  int best = -1;
+  for (int k = 0; k < num_steps; ++k) {
+    ssd[k] = PatchSsd(current, patch, start + k * direction);
+    if (ssd[k] < kInf && (best < 0 || ssd[k] < ssd[best])) best = k;
+  }
+  if (best < 0) return StereoStatus::kOutside;
+  double second = kInf;
+  for (int k = 0; k < num_steps; ++k) {
+    if (std::abs(k - best) > 2) second = std::min(second, ssd[k]);
+  }
+  if (std::sqrt(ssd[best] / 5.0) > options.max_ssd_rms) return StereoStatus::kLargeError;
+  if (second < options.ssd_uniqueness_ratio * ssd[best]) return StereoStatus::kNotUnique;
+  // Sub-pixel: vertex of the parabola through the neighbouring SSDs.
+  double offset = 0.0;
+  if (best > 0 && best + 1 < num_steps && ssd[best - 1] < kInf && ssd[best + 1] < kInf) {
+    const double curvature = ssd[best - 1] - 2.0 * ssd[best] + ssd[best + 1];
+    if (curvature > 1e-12) {
+      offset = std::clamp(0.5 * (ssd[best - 1] - ssd[best + 1]) / curvature, -0.5, 0.5);
+    }
+  }
+  const Eigen::Vector2d match = start + (best + offset) * direction;
+  const double idepth = geometry.IdepthFromCurPixel(pixel_in_ref, match, direction);
+  if (!std::isfinite(idepth) || idepth < 0.0) return StereoStatus::kOutside;
+  Eigen::Vector2d check;
+  if (!geometry.Project(pixel_in_ref, idepth, &check)) return StereoStatus::kOutside;
+  const double jacobian_sq = geometry.IdepthJacobian(pixel_in_ref, idepth).squaredNorm();
+  if (!(jacobian_sq > 1e-12)) return StereoStatus::kBadGeometry;
+  const double disparity_var =
+      GeometricDisparityVar(patch, options.sigma_epipolar_px) +
+      PhotometricDisparityVar(current, patch, match, options.sigma_intensity);
+  if (!std::isfinite(disparity_var)) return StereoStatus::kOutside;
+  observation->idepth = idepth;
+  observation->disparity_var = disparity_var;
+  observation->idepth_var = disparity_var / jacobian_sq;  // alpha^2 sigma_lambda^2
+  observation->pixel_in_cur = match;
+  observation->ssd = ssd[best];
+  return StereoStatus::kOk;
+}
+
+}  // namespace pldvo

@@ -1,0 +1,191 @@
+#include "backend/mapping_worker.h"
+
+#include <glog/logging.h>
+
+#include <chrono>
+#include <exception>
+#include <utility>
+
+#include "backend/reference_builder.h"
+
+namespace pldvo {
+
+MappingWorker::MappingWorker(const PinholeCamera& camera, const MappingOptions& options,
+                             bool parallel, int max_pending_updates)
+    : camera_(camera),
+      options_(options),
+      parallel_(parallel),
+      max_pending_updates_(std::max(1, max_pending_updates)),
+      mapper_(camera, options) {
+  if (parallel_) thread_ = std::thread(&MappingWorker::ThreadLoop, this);
+}
+
+MappingWorker::~MappingWorker() {
+  if (thread_.joinable()) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    job_ready_.notify_all();
+    thread_.join();
+  }
+}
+
+void MappingWorker::Submit(MappingJob job) {
+  if (!parallel_) {
+    Run(job);
+    return;
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (job.kind == MappingJob::Kind::kUpdate) {
+      int pending = 0;
+      for (const MappingJob& queued : queue_) pending += queued.kind == MappingJob::Kind::kUpdate;
+      if (pending >= max_pending_updates_) {
+        for (auto it = queue_.begin(); it != queue_.end(); ++it) {
+          if (it->kind == MappingJob::Kind::kUpdate) {
+            queue_.erase(it);
+            ++dropped_updates_;
+            break;
+          }
+        }
+      }
+    }
+    queue_.push_back(std::move(job));
+  }
+  job_ready_.notify_one();
+}
+
+std::shared_ptr<const KeyframeMap> MappingWorker::Latest() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return latest_;
+}
+
+std::shared_ptr<const KeyframeMap> MappingWorker::WaitForKeyframe(int keyframe_id) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  job_done_.wait(lock, [&] {
+    return (latest_ != nullptr && latest_->keyframe_id == keyframe_id) ||
+           failed_keyframe_id_ == keyframe_id || (queue_.empty() && !busy_);
+  });
+  return latest_;
+}
+
+void MappingWorker::Flush() {
+  if (!parallel_) return;
+  std::unique_lock<std::mutex> lock(mutex_);
+  job_done_.wait(lock, [&] { return queue_.empty() && !busy_; });
+}
+
+std::vector<double> MappingWorker::JobTimesMs() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return job_ms_;
+}
+
+double MappingWorker::TakeRecentJobMs() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const double ms = recent_job_ms_;
+  recent_job_ms_ = 0.0;
+  return ms;
+}
+
+int MappingWorker::dropped_updates() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return dropped_updates_;
+}
+
+int MappingWorker::failed_jobs() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return failed_jobs_;
+}
+
+void MappingWorker::ThreadLoop() {
+  while (true) {
+    MappingJob job;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      job_ready_.wait(lock, [&] { return stop_ || !queue_.empty(); });
+      if (queue_.empty()) return;  // stop_ and nothing left
+      job = std::move(queue_.front());
+      queue_.pop_front();
+      busy_ = true;
+    }
+    Run(job);
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      busy_ = false;
+    }
+    job_done_.notify_all();
+  }
+}
+
+void MappingWorker::Publish(std::shared_ptr<KeyframeMap> keyframe_map) {
+  keyframe_map->reference = std::make_shared<const TrackingReference>(
+      BuildReferencePoints(*keyframe_map->map, keyframe_levels_, camera_));
+  keyframe_map->mean_idepth = MeanInverseDepth(*keyframe_map->map);
+  keyframe_map->num_points =
+      keyframe_map->reference->levels.empty()
+          ? 0
+          : static_cast<int>(keyframe_map->reference->levels[0].points.size());
+  std::lock_guard<std::mutex> lock(mutex_);
+  latest_ = std::move(keyframe_map);
+}
+
+void MappingWorker::Run(const MappingJob& job) {
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    auto published = std::make_shared<KeyframeMap>();
+    switch (job.kind) {
+      case MappingJob::Kind::kInitialize:
+        if (!job.depth.empty()) {
+          mapper_.InitializeKeyframeFromDepth(job.image, job.edges, job.depth,
+                                              job.depth_idepth_var);
+        } else {
+          mapper_.InitializeKeyframe(job.image, job.edges);
+          published->random_init = true;
+        }
+        keyframe_levels_ = ImagePyramid(job.image, job.num_levels);
+        keyframe_id_ = job.keyframe_id;
+        num_updates_ = 0;
+        break;
+      case MappingJob::Kind::kUpdate:
+        if (job.keyframe_id != keyframe_id_) return;  // for a keyframe no longer current
+        mapper_.UpdateWithFrame(job.image, job.cur_from_kf, job.lines_in_cur);
+        ++num_updates_;
+        break;
+      case MappingJob::Kind::kNewKeyframe: {
+        if (job.keep_retired_map) {
+          published->retired_map = std::make_shared<const SemiDenseDepthMap>(
+              mapper_.RegularizedMap(options_.regularize, options_.line_regularization));
+          published->retired_keyframe_id = keyframe_id_;
+        }
+        published->propagation =
+            mapper_.PropagateToNewKeyframe(job.image, job.edges, job.new_from_old);
+        if (mapper_.depth_map().CountValid() < job.min_propagated_points) {
+          mapper_.InitializeKeyframe(job.image, job.edges);
+          published->random_init = true;
+        }
+        keyframe_levels_ = ImagePyramid(job.image, job.num_levels);
+        keyframe_id_ = job.keyframe_id;
+        num_updates_ = 0;
+        break;
+      }
+    }
+    published->keyframe_id = keyframe_id_;
+    published->num_updates = num_updates_;
+    published->map = std::make_shared<const SemiDenseDepthMap>(
+        mapper_.RegularizedMap(options_.regularize, options_.line_regularization));
+    Publish(std::move(published));
+  } catch (const std::exception& e) {
+    LOG(WARNING) << "mapping job for frame " << job.frame_index << " failed: " << e.what();
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++failed_jobs_;
+    if (job.kind != MappingJob::Kind::kUpdate) failed_keyframe_id_ = job.keyframe_id;
+  }
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::lock_guard<std::mutex> lock(mutex_);
+  job_ms_.push_back(ms);
+  recent_job_ms_ += ms;
+}
+
+}  // namespace pldvo

@@ -1,0 +1,408 @@
+#include "backend/odometry.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "backend/keyframe_selector.h"
+#include "backend/reference_builder.h"
+
+namespace pldvo {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double MsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// a is a better tracking result than b: not lost beats lost, then more inlier rows at the
+// finest level. (Not the lower RMS: a wrong pose that pushes points out of the image or onto
+// flat regions can have fewer valid rows and a lower RMS; measured in docs/odometry.md.)
+bool Better(const TrackingResult& a, const TrackingResult& b) {
+  const bool a_lost = a.status == TrackingStatus::kLost;
+  const bool b_lost = b.status == TrackingStatus::kLost;
+  if (a_lost != b_lost) return !a_lost;
+  const int a_inliers = a.levels.empty() ? 0 : a.levels.back().inlier_rows;
+  const int b_inliers = b.levels.empty() ? 0 : b.levels.back().inlier_rows;
+  return a_inliers > b_inliers;
+}
+
+// Maps keyframe segments into the frame with the homography of cur_from_kf and the
+// fronto-parallel plane at inverse depth `idepth` (z = 1 / idepth in the keyframe):
+// H = K (R + t idepth e3^T) K^-1.
+SegmentPredictor MakePredictor(const PinholeCamera& camera, const SE3& cur_from_kf, double idepth) {
+  const Eigen::Matrix3d k = camera.K();
+  Eigen::Matrix3d m = cur_from_kf.rotation_matrix();
+  m.col(2) += idepth * cur_from_kf.translation();
+  return PredictorFromHomography(k * m * k.inverse());
+}
+
+}  // namespace
+
+const char* FrameStatusName(FrameStatus status) {
+  switch (status) {
+    case FrameStatus::kKeyframe:
+      return "keyframe";
+    case FrameStatus::kTracked:
+      return "tracked";
+    case FrameStatus::kRecovered:
+      return "recovered";
+    case FrameStatus::kLost:
+      return "lost";
+    case FrameStatus::kReinitialized:
+      return "reinitialized";
+    case FrameStatus::kFailed:
+      return "failed";
+  }
+  return "unknown";
+}
+
+Odometry::Odometry(const PinholeCamera& camera, const OdometryConfig& config,
+                   OdometryObserver* observer)
+    : camera_(camera), config_(config), observer_(observer), tracker_(config.tracking) {
+  const std::string camera_error = camera.Check();
+  if (!camera_error.empty()) throw std::invalid_argument("Odometry: camera: " + camera_error);
+  const std::string error = config.Check();
+  if (!error.empty()) throw std::invalid_argument("Odometry: config: " + error);
+  if (config_.odometry.use_lines) frontend_ = std::make_unique<LineFrontend>(config_.lines);
+  mapper_ =
+      std::make_unique<MappingWorker>(camera_, config_.mapping, config_.odometry.parallel_mapping,
+                                      config_.odometry.mapping_queue_size);
+}
+
+Odometry::~Odometry() = default;
+
+OdometryStatistics Odometry::statistics() const {
+  OdometryStatistics stats = stats_;
+  stats.dropped_mapping_updates = mapper_->dropped_updates();
+  stats.failed_mapping_jobs = mapper_->failed_jobs();
+  return stats;
+}
+
+SE3 Odometry::PredictWorldFromCam(int index) const {
+  const int frames = std::max(1, index - last_good_index_);
+  return world_from_last_good_ * SE3::Exp(static_cast<double>(frames) * velocity_.Log());
+}
+
+OdometryFrameResult Odometry::ProcessFrame(int index, double timestamp, const cv::Mat& image,
+                                           const cv::Mat& depth) {
+  if (image.empty() || image.channels() != 1 || image.cols != camera_.width ||
+      image.rows != camera_.height) {
+    throw std::invalid_argument("Odometry::ProcessFrame: frame " + std::to_string(index) +
+                                " is not a gray image of " + std::to_string(camera_.width) + "x" +
+                                std::to_string(camera_.height));
+  }
+  const auto start = Clock::now();
+  OdometryFrameResult result;
+  try {
+    result = Process(index, timestamp, image, depth);
+  } catch (const std::exception& e) {
+    return SkipFrame(index, timestamp, std::string("processing failed: ") + e.what());
+  }
+  result.timing.tracking_thread_ms = MsSince(start);
+  return Finalize(std::move(result));
+}
+
+OdometryFrameResult Odometry::SkipFrame(int index, double timestamp, const std::string& reason) {
+  OdometryFrameResult result;
+  result.index = index;
+  result.timestamp = timestamp;
+  result.status = FrameStatus::kFailed;
+  result.world_from_cam = initialized_ ? PredictWorldFromCam(index) : SE3();
+  result.keyframe_id = keyframe_.id;
+  result.message = reason;
+  if (initialized_) {
+    ++consecutive_lost_;
+    recovering_ = true;
+  }
+  return Finalize(std::move(result));
+}
+
+OdometryFrameResult Odometry::Finalize(OdometryFrameResult result) {
+  result.timing.mapping_ms = mapper_->TakeRecentJobMs();
+  ++stats_.frames;
+  const bool tracked = IsTracked(result.status);
+  if (tracked) {
+    ++stats_.tracked;
+  } else {
+    ++stats_.lost_frames;
+    // A lost event starts at the first non-tracked frame after a tracked one.
+    if (last_index_ < 0 || last_tracked_) ++stats_.lost_events;
+  }
+  if (result.status == FrameStatus::kReinitialized) ++stats_.reinitializations;
+  last_tracked_ = tracked;
+  last_index_ = result.index;
+  if (observer_ != nullptr) observer_->OnFrame(result);
+  return result;
+}
+
+void Odometry::StartKeyframe(int index, double timestamp, const cv::Mat& image, LineFrame lines,
+                             const SE3& world_from_cam, bool initialize, const SE3& new_from_old,
+                             int min_propagated_points, OdometryTiming* timing,
+                             const cv::Mat& depth) {
+  MappingJob job;
+  job.kind = initialize ? MappingJob::Kind::kInitialize : MappingJob::Kind::kNewKeyframe;
+  job.keyframe_id = next_keyframe_id_++;
+  job.frame_index = index;
+  job.image = image;
+  job.num_levels = config_.odometry.num_levels;
+  job.new_from_old = new_from_old;
+  job.min_propagated_points = min_propagated_points;
+  if (initialize && config_.odometry.init_depth_idepth_var > 0.0 && !depth.empty()) {
+    job.depth = depth;
+    job.depth_idepth_var = config_.odometry.init_depth_idepth_var;
+  }
+  const bool want_maps = observer_ != nullptr && observer_->WantsKeyframeMaps();
+  job.keep_retired_map = want_maps && !initialize;
+  if (frontend_ != nullptr && !lines.segments.empty()) {
+    // Every keyframe segment is traced: its pixels get an edge id in the map, and whichever of
+    // them a later frame matches gives point-to-line residuals and line-guided stereo.
+    std::vector<LineMatch> all(lines.segments.size());
+    for (size_t i = 0; i < all.size(); ++i) all[i].ref_index = static_cast<int>(i);
+    LineFrontendTiming trace_timing;
+    job.edges = frontend_->TraceMatched(lines, all, &trace_timing);
+    timing->tracing_ms += trace_timing.tracing_ms;
+  }
+  if (job.keep_retired_map) retiring_ = keyframe_;
+  keyframe_ = ActiveKeyframe();
+  keyframe_.id = job.keyframe_id;
+  keyframe_.frame_index = index;
+  keyframe_.timestamp = timestamp;
+  keyframe_.world_from_kf = world_from_cam;
+  keyframe_.image = image;
+  keyframe_.lines = std::move(lines);
+  ++stats_.keyframes;
+  mapper_->Submit(std::move(job));
+}
+
+void Odometry::NotifyRetired(const KeyframeMap& map) {
+  if (observer_ == nullptr || retiring_.id < 0 || map.retired_map == nullptr ||
+      map.retired_keyframe_id != retiring_.id) {
+    return;
+  }
+  KeyframeInfo info;
+  info.keyframe_id = retiring_.id;
+  info.frame_index = retiring_.frame_index;
+  info.timestamp = retiring_.timestamp;
+  info.world_from_kf = retiring_.world_from_kf;
+  info.image = retiring_.image;
+  info.camera = camera_;
+  observer_->OnKeyframeFinished(info, *map.retired_map);
+  retiring_ = ActiveKeyframe();
+}
+
+void Odometry::RefreshMap(OdometryTiming* timing) {
+  if (map_ == nullptr || map_->keyframe_id != keyframe_.id) {
+    const auto start = Clock::now();
+    map_ = mapper_->WaitForKeyframe(keyframe_.id);
+    timing->wait_ms += MsSince(start);
+    if (map_ != nullptr) NotifyRetired(*map_);
+  } else {
+    map_ = mapper_->Latest();
+  }
+}
+
+TrackingResult Odometry::TrackWithAlternatives(const ImagePyramid& pyramid, const cv::Mat& image,
+                                               int index, const SE3& prior_cur_from_kf,
+                                               const SE3& last_good_cur_from_kf, int* tried) {
+  TrackingIterationCallback callback;
+  if (observer_ != nullptr && observer_->WantsTrackingIterations(index)) {
+    callback = [this, index, &image](const TrackingIteration& iteration) {
+      observer_->OnTrackingIteration(index, image, iteration);
+    };
+  }
+  TrackingResult best = tracker_.Track(reference_, pyramid, prior_cur_from_kf, callback);
+  *tried = 1;
+  const OdometryOptions& options = config_.odometry;
+  const bool high_rms = rms_mean_ > 0.0 && best.final_rms > options.retry_rms_ratio * rms_mean_;
+  if (!options.try_alternatives || (best.status != TrackingStatus::kLost && !high_rms)) {
+    return best;
+  }
+  const double angle = options.alternative_rotation_deg * M_PI / 180.0;
+  std::vector<SE3> guesses = {last_good_cur_from_kf};
+  const Eigen::Vector3d axes[] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY()};
+  for (const Eigen::Vector3d& axis : axes) {
+    for (const double sign : {1.0, -1.0}) {
+      guesses.push_back(SE3(ExpSO3(sign * angle * axis), Eigen::Vector3d::Zero()) *
+                        last_good_cur_from_kf);
+    }
+  }
+  for (const SE3& guess : guesses) {
+    TrackingResult result = tracker_.Track(reference_, pyramid, guess, callback);
+    ++*tried;
+    if (Better(result, best)) best = std::move(result);
+  }
+  return best;
+}
+
+OdometryFrameResult Odometry::Process(int index, double timestamp, const cv::Mat& image,
+                                      const cv::Mat& depth) {
+  OdometryFrameResult result;
+  result.index = index;
+  result.timestamp = timestamp;
+  OdometryTiming& timing = result.timing;
+
+  auto start = Clock::now();
+  const ImagePyramid pyramid(image, config_.odometry.num_levels);
+  timing.pyramid_ms = MsSince(start);
+
+  LineFrame lines;
+  if (frontend_ != nullptr) {
+    lines = frontend_->Process(image);
+    timing.detection_ms = lines.timing.detection_ms + lines.timing.merging_ms;
+    timing.description_ms = lines.timing.description_ms;
+    result.num_lines = static_cast<int>(lines.segments.size());
+  }
+
+  if (!initialized_) {
+    StartKeyframe(index, timestamp, image, std::move(lines), SE3(), true, SE3(), 0, &timing, depth);
+    initialized_ = true;
+    world_from_last_good_ = SE3();
+    last_good_index_ = index;
+    velocity_ = SE3();
+    result.status = FrameStatus::kKeyframe;
+    result.keyframe_id = keyframe_.id;
+    return result;
+  }
+
+  RefreshMap(&timing);
+  result.keyframe_id = keyframe_.id;
+  const SE3 world_from_prior = PredictWorldFromCam(index);
+  const SE3 prior_cur_from_kf = world_from_prior.Inverse() * keyframe_.world_from_kf;
+  const SE3 last_good_cur_from_kf = world_from_last_good_.Inverse() * keyframe_.world_from_kf;
+
+  TrackingResult tracking;
+  const bool have_map = map_ != nullptr && map_->keyframe_id == keyframe_.id &&
+                        map_->reference != nullptr && map_->num_points > 0;
+  if (have_map) {
+    result.num_reference_points = map_->num_points;
+    result.mean_idepth = map_->mean_idepth;
+    std::vector<MatchedLine> lines_in_cur;
+    if (frontend_ != nullptr && !keyframe_.lines.segments.empty() && !lines.segments.empty()) {
+      const SegmentPredictor predictor =
+          config_.odometry.predict_line_matches
+              ? MakePredictor(camera_, prior_cur_from_kf, map_->mean_idepth)
+              : SegmentPredictor();
+      LineFrontendTiming match_timing;
+      const std::vector<LineMatch> matches =
+          frontend_->Match(keyframe_.lines, lines, predictor, &match_timing);
+      timing.matching_ms = match_timing.matching_ms;
+      result.num_matches = static_cast<int>(matches.size());
+      lines_in_cur = MatchedLinesFromMatches(matches, lines.segments,
+                                             static_cast<int>(keyframe_.lines.segments.size()));
+    }
+    start = Clock::now();
+    if (reference_source_ != map_->reference.get()) {
+      reference_ = *map_->reference;
+      reference_source_ = map_->reference.get();
+    }
+    SetMatchedLines(lines_in_cur, &reference_);
+    timing.reference_ms = MsSince(start);
+
+    start = Clock::now();
+    if (config_.odometry.line_prior_gate_px > 0.0 && result.num_matches > 0) {
+      result.num_line_outliers = RemoveLineOutliers(
+          prior_cur_from_kf, config_.odometry.line_prior_gate_px, &reference_, &lines_in_cur);
+    }
+    tracking = TrackWithAlternatives(pyramid, image, index, prior_cur_from_kf,
+                                     last_good_cur_from_kf, &result.alternatives_tried);
+    if (config_.odometry.line_outlier_px > 0.0 && result.num_matches > 0 &&
+        tracking.status != TrackingStatus::kLost) {
+      const int outliers = RemoveLineOutliers(
+          tracking.cur_from_ref, config_.odometry.line_outlier_px, &reference_, &lines_in_cur);
+      result.num_line_outliers += outliers;
+      if (outliers > 0) {
+        TrackingResult again = tracker_.Track(reference_, pyramid, tracking.cur_from_ref);
+        if (again.status != TrackingStatus::kLost) tracking = std::move(again);
+      }
+    }
+    timing.tracking_ms = MsSince(start);
+
+    if (tracking.status != TrackingStatus::kLost) {
+      const SE3 cur_from_kf = tracking.cur_from_ref;
+      const SE3 world_from_cur = keyframe_.world_from_kf * cur_from_kf.Inverse();
+      const int frames = std::max(1, index - last_good_index_);
+      velocity_ = SE3::Exp((world_from_last_good_.Inverse() * world_from_cur).Log() /
+                           static_cast<double>(frames));
+      world_from_last_good_ = world_from_cur;
+      last_good_index_ = index;
+      rms_mean_ = rms_mean_ > 0.0 ? 0.9 * rms_mean_ + 0.1 * tracking.final_rms : tracking.final_rms;
+      result.world_from_cam = world_from_cur;
+      result.status = recovering_ ? FrameStatus::kRecovered : FrameStatus::kTracked;
+      consecutive_lost_ = 0;
+      recovering_ = false;
+      ++keyframe_.frames_tracked;
+
+      start = Clock::now();
+      const int overlap_level = std::min(2, reference_.num_levels() - 1);
+      const double overlap = ReferenceOverlap(reference_, overlap_level, cur_from_kf);
+      timing.reference_ms += MsSince(start);
+      const KeyframeDecision decision = DecideKeyframe(
+          config_.keyframes, cur_from_kf, map_->mean_idepth, overlap, keyframe_.frames_tracked);
+      if (decision.new_keyframe) {
+        StartKeyframe(index, timestamp, image, std::move(lines), world_from_cur, false, cur_from_kf,
+                      0, &timing);
+        result.status = FrameStatus::kKeyframe;
+        result.keyframe_id = keyframe_.id;
+        result.message = "new keyframe: " + decision.reason;
+      } else {
+        MappingJob job;
+        job.kind = MappingJob::Kind::kUpdate;
+        job.keyframe_id = keyframe_.id;
+        job.frame_index = index;
+        job.image = image;
+        job.cur_from_kf = cur_from_kf;
+        job.lines_in_cur = std::move(lines_in_cur);
+        mapper_->Submit(std::move(job));
+      }
+      result.tracking = std::move(tracking);
+      return result;
+    }
+    result.message = "tracking lost (valid residuals " + std::to_string(tracking.valid_residuals) +
+                     ", inlier fraction " + std::to_string(tracking.inlier_fraction) + ")";
+  } else {
+    result.message = "keyframe map has no points";
+  }
+
+  // Lost: extrapolate; after reinit_after_lost consecutive lost frames restart at this frame.
+  result.tracking = std::move(tracking);
+  result.world_from_cam = world_from_prior;
+  result.status = FrameStatus::kLost;
+  ++consecutive_lost_;
+  recovering_ = true;
+  if (consecutive_lost_ >= config_.odometry.reinit_after_lost) {
+    StartKeyframe(index, timestamp, image, std::move(lines), world_from_prior, false,
+                  prior_cur_from_kf, config_.odometry.reinit_min_points, &timing);
+    world_from_last_good_ = world_from_prior;
+    last_good_index_ = index;
+    consecutive_lost_ = 0;
+    result.status = FrameStatus::kReinitialized;
+    result.keyframe_id = keyframe_.id;
+    result.message += "; re-initialised at this frame";
+  }
+  return result;
+}
+
+void Odometry::Finish() {
+  mapper_->Flush();
+  if (observer_ == nullptr || !observer_->WantsKeyframeMaps() || keyframe_.id < 0) return;
+  const std::shared_ptr<const KeyframeMap> map = mapper_->Latest();
+  if (map == nullptr) return;
+  NotifyRetired(*map);
+  if (map->keyframe_id != keyframe_.id || map->map == nullptr) return;
+  KeyframeInfo info;
+  info.keyframe_id = keyframe_.id;
+  info.frame_index = keyframe_.frame_index;
+  info.timestamp = keyframe_.timestamp;
+  info.world_from_kf = keyframe_.world_from_kf;
+  info.image = keyframe_.image;
+  info.camera = camera_;
+  observer_->OnKeyframeFinished(info, *map->map);
+}
+
+}  // namespace pldvo

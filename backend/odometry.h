@@ -1,0 +1,130 @@
+// Frame-to-keyframe monocular odometry with points and lines (Yang & Scherer, ICRA 2017, on
+// Engel et al.'s semi-dense VO): what `pldvo run` drives. See docs/odometry.md.
+//
+// Per frame (ProcessFrame, on the caller's thread):
+//   1. image pyramid; line detection, merging and LBD (frontend/line_frontend.h);
+//   2. the keyframe's latest map (MappingWorker); keyframe lines matched into the frame, gated
+//      around their prediction by the pose prior;
+//   3. the tracking reference: the map's points per level (reference_builder.h) with the matched
+//      current lines;
+//   4. coarse-to-fine tracking (backend/tracker.h) from the constant-velocity prior; when lost or
+//      the RMS stays high, alternative initial guesses (zero motion, small rotations);
+//   5. tracked: the keyframe criteria (keyframe_selector.h) either queue a depth-filter update
+//      with the frame or make it the new keyframe (its edges traced, the map propagated);
+//      lost: the pose is extrapolated, and after odometry.reinit_after_lost consecutive lost
+//      frames the frame becomes a keyframe at the extrapolated pose (propagated or fresh map).
+// The first frame is a keyframe with a random inverse-depth map of large variance (monocular
+// initialisation; the scale is arbitrary). Mapping runs in its own thread unless
+// odometry.parallel_mapping is false (deterministic).
+#ifndef PLDVO_BACKEND_ODOMETRY_H_
+#define PLDVO_BACKEND_ODOMETRY_H_
+
+#include <memory>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "backend/mapping_worker.h"
+#include "backend/odometry_config.h"
+#include "backend/odometry_observer.h"
+#include "backend/tracker.h"
+#include "core/image_pyramid.h"
+#include "core/pinhole_camera.h"
+#include "core/se3.h"
+#include "frontend/line_frontend.h"
+
+namespace pldvo {
+
+struct OdometryStatistics {
+  int frames = 0;
+  int tracked = 0;  // IsTracked(status)
+  int keyframes = 0;
+  int lost_frames = 0;  // lost, reinitialized or failed
+  int lost_events = 0;  // maximal runs of consecutive non-tracked frames
+  int reinitializations = 0;
+  int dropped_mapping_updates = 0;
+  int failed_mapping_jobs = 0;
+};
+
+class Odometry {
+ public:
+  // Throws std::invalid_argument when the config or camera is invalid. `observer` may be null
+  // and must outlive the odometry.
+  Odometry(const PinholeCamera& camera, const OdometryConfig& config,
+           OdometryObserver* observer = nullptr);
+  ~Odometry();
+
+  // Processes the next frame (image CV_32F or CV_8U of the camera's size). Frames must come in
+  // increasing index order. Throws std::invalid_argument on a wrong image size; any other failure
+  // inside is caught and returned as a kFailed frame.
+  // `depth` (CV_32F z-depth in metres, optional) is used only for the first keyframe and only
+  // when odometry.init_depth_idepth_var > 0.
+  OdometryFrameResult ProcessFrame(int index, double timestamp, const cv::Mat& image,
+                                   const cv::Mat& depth = cv::Mat());
+  // A frame that could not be loaded: kFailed with the extrapolated pose.
+  OdometryFrameResult SkipFrame(int index, double timestamp, const std::string& reason);
+  // Waits for the mapping thread and reports the last keyframe's map to the observer.
+  void Finish();
+
+  OdometryStatistics statistics() const;
+  // Wall time of every mapping job (ms), for the summary.
+  std::vector<double> MappingJobTimesMs() const { return mapper_->JobTimesMs(); }
+  const OdometryConfig& config() const { return config_; }
+
+ private:
+  struct ActiveKeyframe {
+    int id = -1;
+    int frame_index = -1;
+    double timestamp = 0.0;
+    SE3 world_from_kf;
+    cv::Mat image;
+    LineFrame lines;
+    int frames_tracked = 0;
+  };
+
+  OdometryFrameResult Process(int index, double timestamp, const cv::Mat& image,
+                              const cv::Mat& depth);
+  // Makes the frame the keyframe with id next_keyframe_id_: initial (random map) when
+  // `initialize`, otherwise propagated from the current keyframe with new_from_old.
+  void StartKeyframe(int index, double timestamp, const cv::Mat& image, LineFrame lines,
+                     const SE3& world_from_cam, bool initialize, const SE3& new_from_old,
+                     int min_propagated_points, OdometryTiming* timing,
+                     const cv::Mat& depth = cv::Mat());
+  // The map of the current keyframe, waiting for it after a switch.
+  void RefreshMap(OdometryTiming* timing);
+  TrackingResult TrackWithAlternatives(const ImagePyramid& pyramid, const cv::Mat& image, int index,
+                                       const SE3& prior_cur_from_kf,
+                                       const SE3& last_good_cur_from_kf, int* tried);
+  SE3 PredictWorldFromCam(int index) const;
+  void NotifyRetired(const KeyframeMap& map);
+  OdometryFrameResult Finalize(OdometryFrameResult result);
+
+  PinholeCamera camera_;
+  OdometryConfig config_;
+  OdometryObserver* observer_;
+  std::unique_ptr<LineFrontend> frontend_;
+  Tracker tracker_;
+  std::unique_ptr<MappingWorker> mapper_;
+
+  bool initialized_ = false;
+  int next_keyframe_id_ = 0;
+  ActiveKeyframe keyframe_;
+  ActiveKeyframe retiring_;  // the previous keyframe until its final map is reported
+  std::shared_ptr<const KeyframeMap> map_;
+  TrackingReference reference_;  // map_'s points + this frame's lines
+  const TrackingReference* reference_source_ = nullptr;
+
+  // Motion model: the last good pose, its frame index and the per-frame motion prev_from_cur.
+  SE3 world_from_last_good_;
+  int last_good_index_ = -1;
+  SE3 velocity_;
+  double rms_mean_ = 0.0;  // running mean of the final RMS of good frames
+  int consecutive_lost_ = 0;
+  bool recovering_ = false;   // a frame was lost since the last tracked one
+  bool last_tracked_ = true;  // the previous frame was tracked (lost-event counting)
+  int last_index_ = -1;
+  OdometryStatistics stats_;
+};
+
+}  // namespace pldvo
+
+#endif  // PLDVO_BACKEND_ODOMETRY_H_

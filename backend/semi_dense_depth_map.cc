@@ -1,0 +1,131 @@
+#include "backend/semi_dense_depth_map.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <string>
+
+namespace pldvo {
+
+SemiDenseDepthMap::SemiDenseDepthMap(int width, int height) : width_(width), height_(height) {
+  if (width <= 0 || height <= 0) {
+    throw std::invalid_argument("SemiDenseDepthMap: size must be positive, got " +
+                                std::to_string(width) + "x" + std::to_string(height));
+  }
+  const size_t n = static_cast<size_t>(width) * height;
+  idepth_.assign(n, 0.f);
+  idepth_var_.assign(n, 0.f);
+  valid_.assign(n, 0);
+  candidate_.assign(n, 0);
+  edge_id_.assign(n, -1);
+  validity_.assign(n, 0);
+  blacklist_.assign(n, 0);
+  num_observations_.assign(n, 0);
+}
+
+void SemiDenseDepthMap::SelectPixels(const ImagePyramid& keyframe, const cv::Mat& edge_id_map,
+                                     const MappingOptions& options) {
+  if (keyframe.num_levels() < 1 || keyframe.width(0) != width_ || keyframe.height(0) != height_) {
+    throw std::invalid_argument("SemiDenseDepthMap::SelectPixels: keyframe size differs from map");
+  }
+  if (!edge_id_map.empty() &&
+      (edge_id_map.type() != CV_32S || edge_id_map.cols != width_ || edge_id_map.rows != height_)) {
+    throw std::invalid_argument(
+        "SemiDenseDepthMap::SelectPixels: edge_id_map must be CV_32S of the map's size");
+  }
+  std::fill(valid_.begin(), valid_.end(), 0);
+  std::fill(candidate_.begin(), candidate_.end(), 0);
+  std::fill(edge_id_.begin(), edge_id_.end(), -1);
+  std::fill(validity_.begin(), validity_.end(), 0);
+  std::fill(blacklist_.begin(), blacklist_.end(), 0);
+  std::fill(num_observations_.begin(), num_observations_.end(), 0);
+  const float threshold_sq =
+      static_cast<float>(options.gradient_threshold * options.gradient_threshold);
+  const int b = options.border_px;
+  const cv::Mat& level = keyframe.level(0);
+  for (int y = b; y < height_ - b; ++y) {
+    const float* row = level.ptr<float>(y);
+    const int32_t* ids = edge_id_map.empty() ? nullptr : edge_id_map.ptr<int32_t>(y);
+    for (int x = b; x < width_ - b; ++x) {
+      const int i = Index(x, y);
+      const float gx = row[3 * x + 1], gy = row[3 * x + 2];
+      const int id = ids ? ids[x] : -1;
+      edge_id_[i] = id;
+      candidate_[i] = (id >= 0 || gx * gx + gy * gy >= threshold_sq) ? 1 : 0;
+    }
+  }
+}
+
+void SemiDenseDepthMap::InitializeConstant(double idepth, double idepth_var, int validity) {
+  for (int i = 0; i < num_pixels(); ++i) {
+    if (candidate_[i]) Set(i, idepth, idepth_var, validity);
+  }
+}
+
+void SemiDenseDepthMap::InitializeRandom(double idepth_min, double idepth_max, double idepth_var,
+                                         int seed, int validity) {
+  std::mt19937 rng(static_cast<uint32_t>(seed));
+  std::uniform_real_distribution<double> uniform(idepth_min, idepth_max);
+  for (int i = 0; i < num_pixels(); ++i) {
+    if (candidate_[i]) Set(i, uniform(rng), idepth_var, validity);
+  }
+}
+
+void SemiDenseDepthMap::InitializeFromDepth(const cv::Mat& depth, double idepth_var, int validity) {
+  if (depth.type() != CV_32F || depth.cols != width_ || depth.rows != height_) {
+    throw std::invalid_argument(
+        "SemiDenseDepthMap::InitializeFromDepth: depth must be CV_32F of the map's size");
+  }
+  for (int y = 0; y < height_; ++y) {
+    const float* row = depth.ptr<float>(y);
+    for (int x = 0; x < width_; ++x) {
+      const int i = Index(x, y);
+      if (!candidate_[i] || !(row[x] > 0.f)) continue;
+      Set(i, 1.0 / row[x], idepth_var, validity);
+      num_observations_[i] = 1;
+    }
+  }
+}
+
+void SemiDenseDepthMap::Set(int i, double idepth, double idepth_var, int validity) {
+  idepth_[i] = static_cast<float>(idepth);
+  idepth_var_[i] = static_cast<float>(idepth_var);
+  valid_[i] = 1;
+  validity_[i] = static_cast<int16_t>(validity);
+  num_observations_[i] = 0;
+}
+
+void SemiDenseDepthMap::SetCandidate(int i, bool candidate, int edge_id) {
+  candidate_[i] = candidate ? 1 : 0;
+  edge_id_[i] = edge_id;
+}
+
+bool SemiDenseDepthMap::Fuse(int i, double idepth_obs, double idepth_obs_var,
+                             const MappingOptions& options) {
+  const double prior = idepth_[i], prior_var = idepth_var_[i];
+  const double diff = idepth_obs - prior;
+  const double gate = options.outlier_gate_sigmas;
+  if (diff * diff > gate * gate * (prior_var + idepth_obs_var)) {
+    validity_[i] = static_cast<int16_t>(validity_[i] - options.validity_decrement);
+    if (validity_[i] <= 0) valid_[i] = 0;
+    return false;
+  }
+  const double sum_var = prior_var + idepth_obs_var;
+  idepth_[i] = static_cast<float>((idepth_obs_var * prior + prior_var * idepth_obs) / sum_var);
+  idepth_var_[i] = static_cast<float>(prior_var * idepth_obs_var / sum_var);
+  validity_[i] = static_cast<int16_t>(
+      std::min(options.validity_max, validity_[i] + options.validity_increment));
+  CountObservation(i);
+  return true;
+}
+
+int SemiDenseDepthMap::CountCandidates() const {
+  return static_cast<int>(std::count(candidate_.begin(), candidate_.end(), 1));
+}
+
+int SemiDenseDepthMap::CountValid() const {
+  return static_cast<int>(std::count(valid_.begin(), valid_.end(), 1));
+}
+
+}  // namespace pldvo

@@ -1,0 +1,99 @@
+// The semi-dense inverse-depth map of one keyframe (Engel, Sturm, Cremers, ICCV 2013, Sec. 2):
+// for every selected pixel (high image gradient, or on a traced edge) a Gaussian hypothesis of
+// the inverse depth, mean D = idepth (1/m) and variance V = idepth_var ((1/m)^2), plus the
+// bookkeeping of the semi-dense filter: validity counter (outlier removal), blacklist counter
+// (pixels whose stereo keeps failing), the number of fused stereo observations and the id of the
+// edge the pixel lies on. Storage is flat per-pixel arrays (row-major, index y * width + x);
+// nothing is allocated per pixel.
+#ifndef PLDVO_BACKEND_SEMI_DENSE_DEPTH_MAP_H_
+#define PLDVO_BACKEND_SEMI_DENSE_DEPTH_MAP_H_
+
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "backend/mapping_options.h"
+#include "core/image_pyramid.h"
+
+namespace pldvo {
+
+class SemiDenseDepthMap {
+ public:
+  SemiDenseDepthMap() = default;
+  // An empty map (no candidates, nothing valid). Throws std::invalid_argument on a size <= 0.
+  SemiDenseDepthMap(int width, int height);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  int num_pixels() const { return width_ * height_; }
+  int Index(int x, int y) const { return y * width_ + x; }
+
+  // Selects the candidates of a keyframe: |grad I| >= options.gradient_threshold at level 0 of
+  // `keyframe`, or edge_id_map (CV_32S, -1 = none; may be empty) >= 0, at least
+  // options.border_px from the border. Clears every hypothesis. Throws std::invalid_argument on
+  // mismatched sizes.
+  void SelectPixels(const ImagePyramid& keyframe, const cv::Mat& edge_id_map,
+                    const MappingOptions& options);
+
+  // Initialisations of every candidate (Engel 2013 Sec. 2.1). Constant: idepth, var. Random:
+  // uniform in [idepth_min, idepth_max] from `seed`, variance var.
+  void InitializeConstant(double idepth, double idepth_var, int validity);
+  void InitializeRandom(double idepth_min, double idepth_max, double idepth_var, int seed,
+                        int validity);
+  // From a z-depth image (CV_32F metres, 0 = none): candidates with depth > 0 get 1/depth and
+  // `idepth_var`; counted as observed (tests, ground-truth maps).
+  void InitializeFromDepth(const cv::Mat& depth, double idepth_var, int validity);
+
+  bool candidate(int i) const { return candidate_[i] != 0; }
+  bool valid(int i) const { return valid_[i] != 0; }
+  float idepth(int i) const { return idepth_[i]; }
+  float idepth_var(int i) const { return idepth_var_[i]; }
+  int edge_id(int i) const { return edge_id_[i]; }
+  int validity(int i) const { return validity_[i]; }
+  int blacklist(int i) const { return blacklist_[i]; }
+  int num_observations(int i) const { return num_observations_[i]; }
+
+  // Sets a new hypothesis: marks it valid and resets its observation count.
+  void Set(int i, double idepth, double idepth_var, int validity);
+  // Changes the mean only (regularisation); the pixel must be valid.
+  void SetIdepth(int i, double idepth) { idepth_[i] = static_cast<float>(idepth); }
+  void SetIdepthAndVar(int i, double idepth, double idepth_var) {
+    idepth_[i] = static_cast<float>(idepth);
+    idepth_var_[i] = static_cast<float>(idepth_var);
+  }
+  void Invalidate(int i) { valid_[i] = 0; }
+  void SetCandidate(int i, bool candidate, int edge_id);
+  void AddBlacklist(int i) {
+    if (blacklist_[i] < INT16_MAX) ++blacklist_[i];
+  }
+  void CountObservation(int i) {
+    if (num_observations_[i] < UINT16_MAX) ++num_observations_[i];
+  }
+  void SetValidity(int i, int validity) { validity_[i] = static_cast<int16_t>(validity); }
+
+  // The EKF update of one pixel with an inverse-depth observation (a product of Gaussians):
+  //   D' = (V_obs D + V D_obs) / (V + V_obs),   V' = V V_obs / (V + V_obs).
+  // When |D_obs - D| > gate_sigmas sqrt(V + V_obs) the observation is an outlier: the validity
+  // counter drops by options.validity_decrement and the hypothesis is invalidated at <= 0.
+  // Otherwise the validity rises by options.validity_increment (capped). Returns true when fused.
+  bool Fuse(int i, double idepth_obs, double idepth_obs_var, const MappingOptions& options);
+
+  int CountCandidates() const;
+  int CountValid() const;
+
+ private:
+  int width_ = 0;
+  int height_ = 0;
+  std::vector<float> idepth_;
+  std::vector<float> idepth_var_;
+  std::vector<uint8_t> valid_;
+  std::vector<uint8_t> candidate_;
+  std::vector<int32_t> edge_id_;
+  std::vector<int16_t> validity_;
+  std::vector<int16_t> blacklist_;
+  std::vector<uint16_t> num_observations_;
+};
+
+}  // namespace pldvo
+
+#endif  // PLDVO_BACKEND_SEMI_DENSE_DEPTH_MAP_H_

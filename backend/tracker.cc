@@ -1,0 +1,190 @@
+#include "backend/tracker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "residuals/covariance_models.h"
+#include "residuals/photometric_residual.h"
+#include "residuals/point_to_line_residual.h"
+#include "residuals/se3_manifold.h"
+
+namespace pldvo {
+namespace {
+
+std::string Where(int line) { return std::string(__FILE__) + ":" + std::to_string(line) + ": "; }
+
+std::vector<Eigen::Vector2d> ReprojectEdgePixels(const TrackingReferenceLevel& ref, int level,
+                                                 const SE3& cur_from_ref) {
+  std::vector<Eigen::Vector2d> pixels;
+  for (const ReferencePoint& point : ref.points) {
+    if (point.edge_id < 0) continue;
+    Eigen::Vector2d pixel_cur;
+    if (!Reproject(ref.camera, cur_from_ref, point.pixel, point.idepth, &pixel_cur)) continue;
+    pixels.push_back(PixelAtLevel0(pixel_cur, level));
+  }
+  return pixels;
+}
+
+}  // namespace
+
+std::string TrackingOptions::Check() const {
+  std::string error = solver.Check();
+  if (!error.empty()) return "solver: " + error;
+  error = problem.Check();
+  if (!error.empty()) return "problem: " + error;
+  if (finest_level < 0 || coarsest_level < finest_level) {
+    return "need 0 <= finest_level <= coarsest_level";
+  }
+  if (min_valid_residuals < 0) return "min_valid_residuals must be >= 0";
+  if (!(min_valid_fraction >= 0.0 && min_valid_fraction <= 1.0)) {
+    return "min_valid_fraction must be in [0, 1]";
+  }
+  if (!(inlier_threshold > 0.0)) return "inlier_threshold must be > 0";
+  if (!(min_inlier_fraction >= 0.0 && min_inlier_fraction <= 1.0)) {
+    return "min_inlier_fraction must be in [0, 1]";
+  }
+  return "";
+}
+
+const char* TrackingStatusName(TrackingStatus status) {
+  switch (status) {
+    case TrackingStatus::kConverged:
+      return "converged";
+    case TrackingStatus::kNotConverged:
+      return "not_converged";
+    case TrackingStatus::kLost:
+      return "lost";
+  }
+  return "unknown";
+}
+
+int TrackingResult::TotalIterations() const {
+  int total = 0;
+  for (const LevelResult& level : levels) total += level.iterations;
+  return total;
+}
+
+ResidualStatistics EvaluateResidualStatistics(const LeastSquaresProblem& problem,
+                                              double inlier_threshold) {
+  ResidualStatistics stats;
+  std::vector<double> residuals(problem.MaxBlockResiduals());
+  for (const LeastSquaresProblem::ResidualBlock& block : problem.residual_blocks()) {
+    const int rows = block.cost_function->num_residuals();
+    if (!block.cost_function->Evaluate(block.parameters.data(), residuals.data(), nullptr)) {
+      continue;
+    }
+    double sq_norm = 0.0;
+    for (int i = 0; i < rows; ++i) sq_norm += residuals[i] * residuals[i];
+    if (block.loss_function != nullptr) {
+      double rho[3];
+      block.loss_function->Evaluate(sq_norm, rho);
+      stats.cost += 0.5 * rho[0];
+    } else {
+      stats.cost += 0.5 * sq_norm;
+    }
+    stats.rows += rows;
+    // valid(i) reflects the Evaluate above.
+    const auto* photometric = dynamic_cast<const PhotometricResidual*>(block.cost_function);
+    const auto* line = dynamic_cast<const PointToLineResidual*>(block.cost_function);
+    for (int i = 0; i < rows; ++i) {
+      const bool valid = photometric != nullptr ? photometric->valid(i)
+                         : line != nullptr      ? line->valid(i)
+                                                : true;
+      if (!valid) continue;
+      ++stats.valid_rows;
+      double magnitude = std::abs(residuals[i]);
+      if (block.loss_function != nullptr) {
+        double rho[3];
+        block.loss_function->Evaluate(magnitude * magnitude, rho);
+        magnitude = std::sqrt(std::max(rho[0], 0.0));
+      }
+      if (magnitude <= inlier_threshold) ++stats.inlier_rows;
+    }
+  }
+  return stats;
+}
+
+Tracker::Tracker(const TrackingOptions& options) : options_(options) {
+  const std::string error = options_.Check();
+  if (!error.empty()) throw std::invalid_argument(Where(__LINE__) + "tracking: " + error);
+  builder_ = MakeProblemBuilder(options_.problem_builder, options_.problem);
+  solver_ = MakeSolver(options_.solver);
+}
+
+TrackingResult Tracker::Track(const TrackingReference& reference, const ImagePyramid& current,
+                              const SE3& initial_cur_from_ref,
+                              const TrackingIterationCallback& callback) const {
+  const int available = std::min(reference.num_levels(), current.num_levels());
+  if (available <= options_.finest_level) {
+    throw std::invalid_argument(Where(__LINE__) + "finest_level " +
+                                std::to_string(options_.finest_level) + " but only " +
+                                std::to_string(available) + " levels available");
+  }
+  const int coarsest = std::min(options_.coarsest_level, available - 1);
+
+  double pose[kPoseAmbientSize];
+  PoseToParameters(initial_cur_from_ref, pose);
+  TrackingResult result;
+  for (int level = coarsest; level >= options_.finest_level; --level) {
+    LeastSquaresProblem problem;
+    const BuildStatistics built = builder_->Build(reference, current, level, pose, &problem);
+    LevelResult level_result;
+    level_result.level = level;
+    level_result.residual_rows = built.photometric_residuals + built.line_residuals;
+
+    SolverIterationCallback solver_callback;
+    if (callback) {
+      const TrackingReferenceLevel& ref = reference.levels[level];
+      solver_callback = [&, level](const SolverIteration& iteration) {
+        TrackingIteration info;
+        info.level = level;
+        info.iteration = iteration.iteration;
+        info.cost = iteration.cost;
+        info.step_accepted = iteration.step_accepted;
+        info.cur_from_ref = PoseFromParameters(pose);
+        if (options_.record_edge_pixels) {
+          info.edge_pixels_in_cur = ReprojectEdgePixels(ref, level, info.cur_from_ref);
+        }
+        callback(info);
+      };
+    }
+    if (problem.residual_blocks().empty()) {
+      level_result.solver_message = "no residuals";
+      result.levels.push_back(level_result);
+      continue;
+    }
+    const SolverSummary summary = solver_->Solve(&problem, solver_callback);
+    level_result.iterations = summary.iterations;
+    level_result.initial_cost = summary.initial_cost;
+    level_result.converged = summary.converged;
+    level_result.solver_message = summary.message;
+    const ResidualStatistics final_stats =
+        EvaluateResidualStatistics(problem, options_.inlier_threshold);
+    level_result.final_cost = final_stats.cost;
+    level_result.valid_rows = final_stats.valid_rows;
+    level_result.inlier_rows = final_stats.inlier_rows;
+    level_result.rms = final_stats.valid_rows > 0
+                           ? std::sqrt(2.0 * final_stats.cost / final_stats.valid_rows)
+                           : 0.0;
+    result.levels.push_back(level_result);
+  }
+
+  result.cur_from_ref = PoseFromParameters(pose);
+  const LevelResult& finest = result.levels.back();
+  result.valid_residuals = finest.valid_rows;
+  result.final_rms = finest.rms;
+  result.inlier_fraction =
+      finest.valid_rows > 0 ? static_cast<double>(finest.inlier_rows) / finest.valid_rows : 0.0;
+  const bool lost = finest.valid_rows < std::max(1, options_.min_valid_residuals) ||
+                    finest.valid_rows < options_.min_valid_fraction * finest.residual_rows ||
+                    result.inlier_fraction < options_.min_inlier_fraction;
+  if (lost) {
+    result.status = TrackingStatus::kLost;
+  } else {
+    result.status = finest.converged ? TrackingStatus::kConverged : TrackingStatus::kNotConverged;
+  }
+  return result;
+}
+
+}  // namespace pldvo

@@ -1,0 +1,146 @@
+#include "backend/tracking_problem_builder.h"
+
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+#include "residuals/photometric_residual.h"
+#include "residuals/point_to_line_residual.h"
+#include "residuals/se3_manifold.h"
+
+namespace pldvo {
+namespace {
+
+std::string Where(int line) { return std::string(__FILE__) + ":" + std::to_string(line) + ": "; }
+
+}  // namespace
+
+std::string ProblemBuilderOptions::Check() const {
+  if (batch_size < 1) return "batch_size must be >= 1";
+  return weighting.Check();
+}
+
+std::map<std::string, ProblemBuilderFactory> ProblemBuilderRegistry() {
+  std::map<std::string, ProblemBuilderFactory> registry;
+  registry["tracking"] = [](const ProblemBuilderOptions& options) {
+    return std::make_unique<TrackingProblemBuilder>(options, /*loss_in_problem=*/false);
+  };
+  registry["tracking_ceres_loss"] = [](const ProblemBuilderOptions& options) {
+    return std::make_unique<TrackingProblemBuilder>(options, /*loss_in_problem=*/true);
+  };
+  return registry;
+}
+
+std::unique_ptr<ProblemBuilder> MakeProblemBuilder(const std::string& name,
+                                                   const ProblemBuilderOptions& options) {
+  const std::map<std::string, ProblemBuilderFactory> registry = ProblemBuilderRegistry();
+  const auto it = registry.find(name);
+  if (it == registry.end()) {
+    std::ostringstream known;
+    for (const auto& entry : registry) known << " " << entry.first;
+    throw std::invalid_argument(Where(__LINE__) + "unknown problem builder '" + name +
+                                "'; known:" + known.str());
+  }
+  return it->second(options);
+}
+
+TrackingProblemBuilder::TrackingProblemBuilder(const ProblemBuilderOptions& options,
+                                               bool loss_in_problem)
+    : options_(options), loss_in_problem_(loss_in_problem) {
+  const std::string error = options_.Check();
+  if (!error.empty()) throw std::invalid_argument(Where(__LINE__) + error);
+}
+
+BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference,
+                                              const ImagePyramid& current, int level,
+                                              double* cur_from_ref,
+                                              LeastSquaresProblem* problem) const {
+  if (level < 0 || level >= reference.num_levels() || level >= current.num_levels()) {
+    throw std::invalid_argument(Where(__LINE__) + "level " + std::to_string(level) +
+                                " not in the reference (" + std::to_string(reference.num_levels()) +
+                                ") or the current " + "pyramid (" +
+                                std::to_string(current.num_levels()) + ")");
+  }
+  if (problem->ParameterBlockIndex(cur_from_ref) < 0) {
+    problem->AddParameterBlock(cur_from_ref, kPoseAmbientSize, std::make_unique<SE3Manifold>());
+  }
+  const TrackingReferenceLevel& ref = reference.levels[level];
+  const PinholeCamera& camera = ref.camera;
+  const SE3 pose = PoseFromParameters(cur_from_ref);
+  const WeightingOptions& weighting = options_.weighting;
+
+  ceres::LossFunction* loss = nullptr;
+  if (std::unique_ptr<ceres::LossFunction> made = MakeLossFunction(weighting)) {
+    loss = problem->AddLossFunction(std::move(made));
+  }
+  ceres::LossFunction* loss_inside = loss_in_problem_ ? nullptr : loss;
+  ceres::LossFunction* loss_outside = loss_in_problem_ ? loss : nullptr;
+  const size_t batch = loss_in_problem_ ? 1 : static_cast<size_t>(options_.batch_size);
+
+  BuildStatistics stats;
+  if (UsesPhotometric(weighting.policy)) {
+    std::vector<PhotometricObservation> observations;
+    observations.reserve(batch);
+    auto flush = [&]() {
+      if (observations.empty()) return;
+      stats.photometric_residuals += static_cast<int>(observations.size());
+      ++stats.residual_blocks;
+      problem->AddResidualBlock(std::unique_ptr<ceres::CostFunction>(PhotometricResidual::Create(
+                                    current, level, camera, std::move(observations), loss_inside)),
+                                loss_outside, {cur_from_ref});
+      observations.clear();
+      observations.reserve(batch);
+    };
+    for (const ReferencePoint& point : ref.points) {
+      const double sqrt_info = PhotometricSqrtInfo(weighting, camera, current, level, pose,
+                                                   point.pixel, point.idepth, point.idepth_var);
+      if (!(sqrt_info > 0.0)) continue;
+      PhotometricObservation observation;
+      observation.pixel_in_ref = point.pixel;
+      observation.idepth = point.idepth;
+      observation.intensity_ref = point.intensity;
+      observation.sqrt_info = sqrt_info;
+      observations.push_back(observation);
+      if (observations.size() == batch) flush();
+    }
+    flush();
+  }
+  if (UsesLines(weighting.policy)) {
+    std::vector<PointToLineObservation> observations;
+    observations.reserve(batch);
+    auto flush = [&]() {
+      if (observations.empty()) return;
+      stats.line_residuals += static_cast<int>(observations.size());
+      ++stats.residual_blocks;
+      problem->AddResidualBlock(std::unique_ptr<ceres::CostFunction>(PointToLineResidual::Create(
+                                    camera, std::move(observations), loss_inside)),
+                                loss_outside, {cur_from_ref});
+      observations.clear();
+      observations.reserve(batch);
+    };
+    for (const ReferencePoint& point : ref.points) {
+      if (point.edge_id < 0) continue;
+      if (point.edge_id >= static_cast<int>(ref.lines_in_cur.size())) {
+        throw std::invalid_argument(Where(__LINE__) + "edge id " + std::to_string(point.edge_id) +
+                                    " has no line entry at level " + std::to_string(level));
+      }
+      const MatchedLine& line = ref.lines_in_cur[point.edge_id];
+      if (!line.matched) continue;
+      const double sqrt_info = LineSqrtInfo(weighting, camera, pose, point.pixel, point.idepth,
+                                            point.idepth_var, line.line_in_cur);
+      if (!(sqrt_info > 0.0)) continue;
+      PointToLineObservation observation;
+      observation.pixel_in_ref = point.pixel;
+      observation.idepth = point.idepth;
+      observation.line_in_cur = line.line_in_cur.line;
+      observation.sqrt_info = sqrt_info;
+      observations.push_back(observation);
+      if (observations.size() == batch) flush();
+    }
+    flush();
+  }
+  return stats;
+}
+
+}  // namespace pldvo

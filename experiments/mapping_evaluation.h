@@ -1,0 +1,89 @@
+// The mapping evaluation behind `pldvo mapeval` and tests/backend/depth_mapper_test.cc: a
+// synthetic sequence with ground-truth poses and depth; a keyframe initialised at random is
+// mapped with N tracked frames (GT poses) twice, with photometric stereo alone and with
+// line-guided stereo (GT line matches: the scene's 3D edges projected with the GT poses, endpoint
+// noise line_sigma_px); then the 3D line regularisation, the smoothing and the propagation to the
+// last frame are evaluated. See docs/mapping.md.
+#ifndef PLDVO_EXPERIMENTS_MAPPING_EVALUATION_H_
+#define PLDVO_EXPERIMENTS_MAPPING_EVALUATION_H_
+
+#include <string>
+#include <vector>
+
+#include "backend/line_regularizer.h"
+#include "backend/mapping_ground_truth.h"
+#include "backend/mapping_options.h"
+#include "core/synthetic/synthetic_sequence.h"
+
+namespace pldvo {
+
+struct MapEvalConfig {
+  synthetic::SynthOptions synth;
+  MappingOptions mapping;
+  int keyframe_index = 0;
+  int num_frames = 15;          // tracked frames fused into the keyframe
+  int frame_stride = 2;         // frame k is keyframe_index + k * frame_stride
+  double line_sigma_px = 0.25;  // endpoint noise of the GT current lines (main run, propagation)
+  // Further line-guided runs, one per endpoint noise (the accuracy crossover with photometric).
+  std::vector<double> line_sigma_sweep = {0.1, 0.5, 1.0};
+  int line_seed = 17;
+  // When not empty: the line-guided keyframe map is written there (inverse-depth PNGs raw and
+  // regularised, PLY point cloud). Not a config key.
+  std::string out_dir;
+
+  // Textured preset, 320x240, fx = fy = 262.5. The mapping noise model matches the experiment:
+  // sigma_intensity = the rendered noise (1 gray level); sigma_epipolar_px = 0.1 since the poses
+  // are exact (the library default 0.5 px models tracking error).
+  MapEvalConfig();
+  template <class Visitor>
+  void VisitFields(Visitor& v) {
+    v.Field("keyframe_index", &keyframe_index, "Index of the keyframe in the sequence.");
+    v.Field("num_frames", &num_frames, "Tracked frames fused into the keyframe.");
+    v.Field("frame_stride", &frame_stride, "Frame k is keyframe_index + k * frame_stride.");
+    v.Field("line_sigma_px", &line_sigma_px, "Endpoint noise of the GT current lines, pixels.");
+    v.Field("line_seed", &line_seed, "Seed of that noise.");
+    v.Field("line_sigma_sweep", &line_sigma_sweep,
+            "Endpoint noises of additional line-guided runs, pixels.");
+    v.Section("synth", &synth, "Synthetic sequence.");
+    v.Section("mapping", &mapping, "Mapping options.");
+  }
+  std::string Check() const;
+};
+
+// One mapping run (one stereo variant) and its evaluation.
+struct MapEvalRun {
+  DepthErrorStats all;    // every observed hypothesis vs the GT depth image
+  DepthErrorStats edges;  // observed hypotheses on edge centre pixels vs the GT 3D line
+  DepthErrorStats edges_line_regularized;  // the same after the 3D line regularisation
+  DepthErrorStats all_smoothed;            // `all` after the inverse-variance smoothing
+  LineRegularizationStats line_stats;
+  double line_sigma_px = 0.0;
+  double edge_stereo_us_per_pixel = 0.0;       // stereo wall time per processed edge pixel
+  double first_frame_edge_us_per_pixel = 0.0;  // the same in the first frame (wide priors)
+  double other_stereo_us_per_pixel = 0.0;
+  int line_ok = 0, line_fallback = 0, line_rejected = 0, line_out_of_range = 0, ssd_ok = 0,
+      outliers = 0;
+  int candidates = 0, valid = 0;
+};
+
+struct MapEvalResult {
+  int width = 0, height = 0, num_gt_edges = 0, num_edge_pixels = 0;
+  double baseline_m = 0.0;  // keyframe-to-last-frame distance
+  MapEvalRun photometric;
+  MapEvalRun line_guided;              // at config.line_sigma_px
+  std::vector<MapEvalRun> line_sweep;  // at config.line_sigma_sweep
+  // Edge-pixel stereo time from the random initialisation against the last frame (wide priors,
+  // one update; min over 5 repetitions), microseconds per edge pixel.
+  double wide_prior_photometric_us = 0.0;
+  double wide_prior_line_us = 0.0;
+  DepthErrorStats propagated;  // line-guided map propagated to the last frame vs its GT depth
+  int propagated_count = 0;
+};
+
+// Throws std::invalid_argument on an invalid config.
+MapEvalResult RunMapEvaluation(const MapEvalConfig& config);
+std::string FormatMapEvalTable(const MapEvalResult& result);
+
+}  // namespace pldvo
+
+#endif  // PLDVO_EXPERIMENTS_MAPPING_EVALUATION_H_

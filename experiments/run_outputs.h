@@ -1,0 +1,50 @@
+// The optional outputs of `pldvo run` (config section `output`), written by an OdometryObserver so
+// that the odometry core stays free of file I/O:
+//   OUT/iterations/frame_NNNNNN_lL_iII.png  tracking iterations of every N-th frame: the
+//       keyframe's edge points reprojected with the iteration's pose (green) over the current
+//       frame, the initial pose's reprojection of the level in red (the paper's Fig. 2);
+//   OUT/keyframes/kf_KKKK_idepth.png        the keyframe's inverse-depth map (colour, JET);
+//   OUT/keyframes/kf_KKKK.ply               its semi-dense points in the world frame.
+// Write failures are reported once to stderr and never stop the run.
+#ifndef PLDVO_EXPERIMENTS_RUN_OUTPUTS_H_
+#define PLDVO_EXPERIMENTS_RUN_OUTPUTS_H_
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "backend/odometry_config.h"
+#include "backend/odometry_observer.h"
+
+namespace pldvo {
+
+class RunOutputs : public OdometryObserver {
+ public:
+  RunOutputs(const std::string& out_dir, const OutputOptions& options);
+
+  bool WantsTrackingIterations(int frame_index) const override;
+  void OnTrackingIteration(int frame_index, const cv::Mat& image,
+                           const TrackingIteration& iteration) override;
+  bool WantsKeyframeMaps() const override;
+  void OnKeyframeFinished(const KeyframeInfo& keyframe, const SemiDenseDepthMap& map) override;
+
+  int images_written() const { return images_written_; }
+  int keyframes_written() const { return keyframes_written_; }
+
+ private:
+  void ReportError(const std::string& what);
+
+  std::string out_dir_;
+  OutputOptions options_;
+  // Edge pixels of the current level's first iteration (drawn in red on later iterations).
+  int initial_frame_ = -1;
+  int initial_level_ = -1;
+  std::vector<Eigen::Vector2d> initial_pixels_;
+  int images_written_ = 0;
+  int keyframes_written_ = 0;
+  bool error_reported_ = false;
+};
+
+}  // namespace pldvo
+
+#endif  // PLDVO_EXPERIMENTS_RUN_OUTPUTS_H_

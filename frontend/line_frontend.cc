@@ -1,0 +1,81 @@
+#include "frontend/line_frontend.h"
+
+#include <algorithm>
+#include <chrono>
+#include <stdexcept>
+
+namespace pldvo {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double MillisecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+const LineFrontendOptions& Checked(const LineFrontendOptions& options) {
+  const std::string error = options.Check();
+  if (!error.empty()) throw std::invalid_argument("LineFrontendOptions: " + error);
+  return options;
+}
+
+}  // namespace
+
+LineFrontend::LineFrontend(const LineFrontendOptions& options)
+    : options_(Checked(options)),
+      detector_(options.detector),
+      merger_(options.merger, options.detector.endpoint_sigma_px),
+      describer_(options.descriptor),
+      matcher_(options.matcher),
+      tracer_(options.tracer) {}
+
+LineFrame LineFrontend::Process(const cv::Mat& image) {
+  LineFrame frame;
+  Clock::time_point start = Clock::now();
+  const cv::Mat gray = ToGray8(image);
+  frame.image_size = gray.size();
+  const std::vector<cv::Mat> octaves =
+      BuildOctaves(gray, options_.detector.first_octave + options_.detector.num_octaves);
+  const std::vector<LineSegment> detected = detector_.Detect(octaves);
+  frame.timing.detection_ms = MillisecondsSince(start);
+  frame.timing.num_detected = static_cast<int>(detected.size());
+
+  start = Clock::now();
+  frame.segments = merger_.Merge(detected);
+  frame.timing.merging_ms = MillisecondsSince(start);
+  frame.timing.num_lines = static_cast<int>(frame.segments.size());
+
+  start = Clock::now();
+  frame.descriptors = describer_.Describe(gray, frame.segments);
+  frame.timing.description_ms = MillisecondsSince(start);
+  return frame;
+}
+
+std::vector<LineMatch> LineFrontend::Match(const LineFrame& keyframe, const LineFrame& frame,
+                                           const SegmentPredictor& predictor,
+                                           LineFrontendTiming* timing) const {
+  const Clock::time_point start = Clock::now();
+  std::vector<LineMatch> matches = matcher_.Match(keyframe.segments, keyframe.descriptors,
+                                                  frame.segments, frame.descriptors, predictor);
+  if (timing != nullptr) {
+    timing->matching_ms += MillisecondsSince(start);
+    timing->num_matches += static_cast<int>(matches.size());
+  }
+  return matches;
+}
+
+EdgeTrace LineFrontend::TraceMatched(const LineFrame& keyframe,
+                                     const std::vector<LineMatch>& matches,
+                                     LineFrontendTiming* timing) const {
+  const Clock::time_point start = Clock::now();
+  std::vector<int> ids;
+  ids.reserve(matches.size());
+  for (const LineMatch& match : matches) ids.push_back(match.ref_index);
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  EdgeTrace trace = tracer_.Trace(keyframe.segments, ids, keyframe.image_size);
+  if (timing != nullptr) timing->tracing_ms += MillisecondsSince(start);
+  return trace;
+}
+
+}  // namespace pldvo

@@ -1,0 +1,89 @@
+// Semi-dense mapping on a small synthetic sequence (160x120, 8 frames, textured preset, GT poses)
+// through experiments/mapping_evaluation.h: convergence from a random initialisation, line-guided
+// vs photometric stereo on edge pixels, the 3D line regularisation, NEES and propagation.
+// Measured values at this config (pldvo mapeval with the same --set keys) are quoted next to each
+// tolerance; the tolerances leave ~2x margin on them and sit far from what a broken stage gives
+// (the random initialisation has a median relative error of ~60%).
+#include <gtest/gtest.h>
+
+#include "experiments/mapping_evaluation.h"
+
+namespace pldvo {
+namespace {
+
+MapEvalConfig SmallConfig() {
+  MapEvalConfig config;
+  config.synth.width = 160;
+  config.synth.height = 120;
+  config.synth.fx = 131.25;
+  config.synth.fy = 131.25;
+  config.synth.threads = 2;
+  config.num_frames = 8;
+  config.frame_stride = 3;
+  config.line_sigma_px = 0.25;
+  config.line_sigma_sweep = {0.1};
+  return config;
+}
+
+const MapEvalResult& Result() {
+  static const MapEvalResult result = RunMapEvaluation(SmallConfig());
+  return result;
+}
+
+TEST(DepthMapperTest, ConvergesFromRandomInitialisation) {
+  const MapEvalResult& r = Result();
+  // Measured: 0.033 median relative error over ~7800 hypotheses (of 8342 candidates).
+  EXPECT_GT(r.photometric.all.count, 5000);
+  EXPECT_LT(r.photometric.all.median_rel_error, 0.07);
+  EXPECT_LT(r.line_guided.all.median_rel_error, 0.07);
+}
+
+TEST(DepthMapperTest, LineGuidedAtLeastAsAccurateOnEdges) {
+  const MapEvalResult& r = Result();
+  ASSERT_GT(r.photometric.edges.count, 500);
+  ASSERT_GT(r.line_guided.edges.count, 500);
+  ASSERT_EQ(r.line_sweep.size(), 1u);
+  // With sub-pixel lines (endpoint sigma 0.1 px) the line-guided edge depth is clearly better
+  // (measured 0.007 vs 0.030); at 0.25 px it is still better here (0.018 vs 0.030) but the
+  // crossover is near 0.25-0.5 px (docs/mapping.md), so only the 0.1 px run is held to <=.
+  EXPECT_LE(r.line_sweep[0].edges.median_rel_error, r.photometric.edges.median_rel_error);
+  EXPECT_LT(r.line_guided.edges.median_rel_error, 0.06);
+}
+
+TEST(DepthMapperTest, LineRegularizationReducesEdgeError) {
+  const MapEvalResult& r = Result();
+  // Measured: photometric 0.030 -> 0.013, line-guided 0.018 -> 0.015.
+  EXPECT_LT(r.photometric.edges_line_regularized.median_rel_error,
+            r.photometric.edges.median_rel_error);
+  EXPECT_LT(r.line_guided.edges_line_regularized.median_rel_error,
+            r.line_guided.edges.median_rel_error);
+  EXPECT_GT(r.photometric.line_stats.edges_fitted, 20);
+}
+
+TEST(DepthMapperTest, NeesInSaneBand) {
+  const MapEvalResult& r = Result();
+  // The error distribution is heavy-tailed (depth discontinuities, wrong matches), so the mean
+  // NEES (~200) is dominated by a few percent of outliers; the bulk is checked through the median
+  // NEES (0.455 for a consistent Gaussian filter; measured 1.29 photometric, 0.86 line-guided) and
+  // the fraction within 2 sigma (0.954 if consistent; measured 0.65-0.72). A factor 10 either
+  // way of the median would mean a wrong variance model.
+  for (const MapEvalRun* run : {&r.photometric, &r.line_guided}) {
+    EXPECT_GT(run->all.median_nees, 0.455 / 10.0);
+    EXPECT_LT(run->all.median_nees, 0.455 * 10.0);
+    EXPECT_GT(run->all.within_2sigma, 0.5);
+  }
+  // Line-guided edge pixels: measured median NEES 0.59 (consistent within the same factor).
+  EXPECT_GT(r.line_guided.edges.median_nees, 0.455 / 10.0);
+  EXPECT_LT(r.line_guided.edges.median_nees, 0.455 * 10.0);
+}
+
+TEST(DepthMapperTest, PropagationKeepsAccuracy) {
+  const MapEvalResult& r = Result();
+  // Measured: 5053 hypotheses propagated, median relative error 0.0125 against the new
+  // keyframe's GT depth.
+  EXPECT_GT(r.propagated.count, 2000);
+  EXPECT_LT(r.propagated.median_rel_error, 0.05);
+}
+
+}  // namespace
+}  // namespace pldvo

@@ -1,0 +1,239 @@
+// The odometry on a short synthetic sequence (320x240, lowtex preset, 36 frames at 30 fps) in the
+// deterministic single-thread mode: every frame is tracked and the Sim(3)-aligned trajectory
+// error is small; a blank frame is marked lost and tracking recovers; a run of blank frames
+// triggers the re-initialisation and the odometry continues; the config tree loads the shipped
+// configs and rejects unknown keys.
+#include "backend/odometry.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "backend/odometry_config.h"
+#include "core/config_io.h"
+#include "core/evaluation.h"
+#include "core/synthetic/synthetic_sequence.h"
+
+namespace pldvo {
+namespace {
+
+constexpr int kFrames = 36;
+
+struct RenderedSequence {
+  synthetic::SyntheticSequence sequence;
+  std::vector<cv::Mat> images;  // CV_32F
+  cv::Mat first_depth;          // CV_32F metres, frame 0
+};
+
+const RenderedSequence& Sequence() {
+  static const RenderedSequence rendered = [] {
+    synthetic::SynthOptions options;
+    options.preset = "lowtex";
+    options.frames = kFrames;
+    options.seed = 1;
+    options.width = 320;
+    options.height = 240;
+    options.fx = options.fy = 262.5;
+    options.threads = 2;
+    RenderedSequence result;
+    result.sequence = synthetic::MakeSequence(options);
+    for (int i = 0; i < kFrames; ++i) {
+      cv::Mat image;
+      const synthetic::RenderedFrame frame = synthetic::RenderFrame(result.sequence, i);
+      frame.image.convertTo(image, CV_32F);
+      result.images.push_back(image);
+      if (i == 0) result.first_depth = frame.depth;
+    }
+    return result;
+  }();
+  return rendered;
+}
+
+// Deterministic, and the first keyframe initialised from the rendered depth (inverse-depth
+// sigma 0.01 / m): this checks tracking, mapping, keyframes and propagation without the
+// monocular initialisation, whose convergence from a random map depends on the sequence
+// (docs/odometry.md, "Monocular initialisation"); MonocularRunTracksEveryFrame covers it.
+OdometryConfig DeterministicConfig() {
+  OdometryConfig config;
+  config.odometry.parallel_mapping = false;
+  config.odometry.init_depth_idepth_var = 1e-4;
+  return config;
+}
+
+struct RunResult {
+  std::vector<OdometryFrameResult> frames;
+  OdometryStatistics stats;
+  Trajectory estimate;  // tracked frames
+};
+
+// Runs the sequence; frames listed in `blank` are replaced by a constant gray image.
+RunResult RunSequence(const OdometryConfig& config, const std::vector<int>& blank = {}) {
+  const RenderedSequence& rendered = Sequence();
+  Odometry odometry(rendered.sequence.camera, config);
+  RunResult run;
+  for (int i = 0; i < kFrames; ++i) {
+    cv::Mat image = rendered.images[i];
+    if (std::find(blank.begin(), blank.end(), i) != blank.end()) {
+      image = cv::Mat(image.size(), CV_32F, cv::Scalar(128.0));
+    }
+    const double timestamp = rendered.sequence.ground_truth[i].timestamp;
+    run.frames.push_back(
+        odometry.ProcessFrame(i, timestamp, image, i == 0 ? rendered.first_depth : cv::Mat()));
+    if (IsTracked(run.frames.back().status)) {
+      run.estimate.push_back({timestamp, run.frames.back().world_from_cam});
+    }
+  }
+  odometry.Finish();
+  run.stats = odometry.statistics();
+  return run;
+}
+
+// Tolerances. The camera moves ~0.3 m and ~18 degrees over the 36 frames (lowtex preset,
+// 0.25 m/s and 15 deg/s). The deterministic depth-initialised run measured ATE 1.3 mm, RPE
+// 0.72 cm/s and 0.39 deg/s. Broken parts give errors of the order of the motion itself: a map
+// that converged to a wrong structure measured RPE ~20 cm/s / 6 deg/s (a monocular failure
+// case), lost frames extrapolated at constant velocity or missing depth updates several cm/s.
+// The bounds sit at 4-5x the measured values: far below those failure levels, with room for
+// floating-point differences across platforms and libraries.
+constexpr double kMaxAteM = 0.006;
+constexpr double kMaxRpeCmS = 3.0;
+constexpr double kMaxRpeDegS = 1.5;
+
+TEST(OdometryTest, TracksEveryFrameWithSmallAlignedError) {
+  const RunResult run = RunSequence(DeterministicConfig());
+  ASSERT_EQ(run.frames.size(), static_cast<size_t>(kFrames));
+  for (const OdometryFrameResult& frame : run.frames) {
+    EXPECT_TRUE(IsTracked(frame.status))
+        << "frame " << frame.index << ": " << FrameStatusName(frame.status) << " " << frame.message;
+  }
+  EXPECT_EQ(run.stats.lost_events, 0);
+  EXPECT_GE(run.stats.keyframes, 1);
+  const EvaluationResult eval = EvaluateTrajectory(Sequence().sequence.ground_truth, run.estimate);
+  EXPECT_LT(eval.ate_m, kMaxAteM);
+  EXPECT_LT(eval.rpe_cm_s, kMaxRpeCmS);
+  EXPECT_LT(eval.rpe_deg_s, kMaxRpeDegS);
+  EXPECT_DOUBLE_EQ(eval.coverage, 1.0);
+  // Lines are detected and matched to the keyframe in (nearly) every frame.
+  int frames_with_matches = 0;
+  for (const OdometryFrameResult& frame : run.frames) frames_with_matches += frame.num_matches > 0;
+  EXPECT_GE(frames_with_matches, kFrames - 2);
+}
+
+// The default monocular initialisation (random inverse depth, large variance): every frame is
+// tracked and the run is usable end to end. Its accuracy is not asserted: whether the depth
+// filter converges to the true structure from a random map within the first keyframe depends
+// on the sequence (docs/odometry.md, "Monocular initialisation"; measured on this one: RPE
+// 4.9 cm/s with the default config, 12.3 cm/s with sdvo.yaml; other settings gave ~20).
+TEST(OdometryTest, MonocularRunTracksEveryFrame) {
+  OdometryConfig config;
+  config.odometry.parallel_mapping = false;
+  const RunResult run = RunSequence(config);
+  for (const OdometryFrameResult& frame : run.frames) {
+    EXPECT_TRUE(IsTracked(frame.status))
+        << "frame " << frame.index << ": " << FrameStatusName(frame.status) << " " << frame.message;
+  }
+  EXPECT_EQ(run.stats.lost_events, 0);
+  const EvaluationResult eval = EvaluateTrajectory(Sequence().sequence.ground_truth, run.estimate);
+  EXPECT_GT(eval.coverage, 0.99);
+  EXPECT_TRUE(std::isfinite(eval.ate_m));
+}
+
+TEST(OdometryTest, DeterministicModeRepeatsExactly) {
+  const RunResult a = RunSequence(DeterministicConfig());
+  const RunResult b = RunSequence(DeterministicConfig());
+  ASSERT_EQ(a.estimate.size(), b.estimate.size());
+  for (size_t i = 0; i < a.estimate.size(); ++i) {
+    EXPECT_EQ(a.estimate[i].world_from_cam.translation(),
+              b.estimate[i].world_from_cam.translation());
+  }
+}
+
+TEST(OdometryTest, BlankFrameIsLostAndTrackingRecovers) {
+  const int blank = 20;
+  const RunResult run = RunSequence(DeterministicConfig(), {blank});
+  EXPECT_EQ(run.frames[blank].status, FrameStatus::kLost) << run.frames[blank].message;
+  EXPECT_EQ(run.frames[blank + 1].status, FrameStatus::kRecovered) << run.frames[blank + 1].message;
+  for (int i = 0; i < kFrames; ++i) {
+    if (i != blank) {
+      EXPECT_TRUE(IsTracked(run.frames[i].status)) << "frame " << i;
+    }
+  }
+  EXPECT_EQ(run.stats.lost_events, 1);
+  EXPECT_EQ(run.stats.lost_frames, 1);
+  // The trajectory after the blank frame continues the one before it (same scale and frame):
+  // the error stays within the bounds of the undisturbed run.
+  const EvaluationResult eval = EvaluateTrajectory(Sequence().sequence.ground_truth, run.estimate);
+  EXPECT_LT(eval.ate_m, kMaxAteM);
+  EXPECT_LT(eval.rpe_cm_s, kMaxRpeCmS);
+}
+
+TEST(OdometryTest, LongLossReinitialisesAndContinues) {
+  OdometryConfig config = DeterministicConfig();
+  config.odometry.reinit_after_lost = 2;
+  const std::vector<int> blank = {14, 15, 16, 17};
+  const RunResult run = RunSequence(config, blank);
+  int reinitialized = 0;
+  for (int i : blank) {
+    EXPECT_FALSE(IsTracked(run.frames[i].status)) << "frame " << i;
+    reinitialized += run.frames[i].status == FrameStatus::kReinitialized;
+  }
+  // Frames 15 and 17 complete a run of 2 lost frames each and re-initialise there.
+  EXPECT_EQ(reinitialized, 2);
+  // The keyframe made from blank frame 17 has no points: frame 18 is lost, and frame 19 (a real
+  // image) completes the next run and re-initialises with a fresh random map (nothing survives
+  // the propagation from a blank keyframe). From there on every frame is tracked.
+  EXPECT_EQ(run.frames[18].status, FrameStatus::kLost);
+  EXPECT_EQ(run.frames[19].status, FrameStatus::kReinitialized);
+  EXPECT_EQ(run.stats.reinitializations, 3);
+  EXPECT_EQ(run.stats.lost_events, 1);  // one run of consecutive non-tracked frames, 14..19
+  for (int i = 20; i < kFrames; ++i) {
+    EXPECT_TRUE(IsTracked(run.frames[i].status)) << "frame " << i << ": " << run.frames[i].message;
+  }
+  for (const OdometryFrameResult& frame : run.frames) {
+    EXPECT_TRUE(frame.world_from_cam.translation().allFinite());
+  }
+}
+
+TEST(OdometryConfigTest, UnknownKeyIsAnError) {
+  OdometryConfig config;
+  EXPECT_THROW(ApplyOverrides({"odometry.no_such_key=1"}, &config), std::invalid_argument);
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "pldvo_odometry_bad_config.yaml").string();
+  {
+    std::ofstream file(path);
+    file << "keyframes:\n  max_relative_distanse: 0.2\n";
+  }
+  try {
+    LoadConfigYaml(path, &config);
+    ADD_FAILURE() << "unknown key accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("keyframes.max_relative_distanse"), std::string::npos)
+        << e.what();
+  }
+  std::remove(path.c_str());
+}
+
+TEST(OdometryConfigTest, ShippedConfigsLoadAndTakeTheSolverSwitch) {
+  const std::filesystem::path dir =
+      std::filesystem::path(PLDVO_TEST_DATA_DIR).parent_path().parent_path().parent_path() /
+      "experiments" / "configs";
+  for (const char* name :
+       {"sdvo", "points_lines", "lines_only", "uniform_weights", "fixed_ratio"}) {
+    OdometryConfig config;
+    ASSERT_NO_THROW(LoadConfigYaml((dir / (std::string(name) + ".yaml")).string(), &config))
+        << name;
+    ASSERT_NO_THROW(ApplyOverrides({"tracking.solver=gauss_newton"}, &config)) << name;
+    EXPECT_EQ(config.tracking.solver.type, SolverOptions::Type::kGaussNewton);
+    EXPECT_EQ(config.Check(), "") << name;
+  }
+  EXPECT_NE(DescribeConfig(OdometryConfig()).find("keyframes.max_relative_distance"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace pldvo

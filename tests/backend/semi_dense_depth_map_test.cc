@@ -1,0 +1,206 @@
+// The semi-dense depth map's EKF update and bookkeeping, the epipolar geometry and the SSD search
+// of backend/epipolar_stereo.h, propagation and the output helpers.
+#include "backend/semi_dense_depth_map.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+
+#include "backend/depth_map_io.h"
+#include "backend/depth_propagation.h"
+#include "backend/epipolar_stereo.h"
+
+namespace pldvo {
+namespace {
+
+PinholeCamera TestCamera() {
+  PinholeCamera camera;
+  camera.width = 160;
+  camera.height = 120;
+  camera.fx = camera.fy = 130.0;
+  camera.cx = 79.5;
+  camera.cy = 59.5;
+  return camera;
+}
+
+TEST(SemiDenseDepthMapTest, FuseIsProductOfGaussians) {
+  SemiDenseDepthMap map(4, 4);
+  MappingOptions options;
+  map.Set(5, 0.5, 0.04, options.validity_initial);
+  ASSERT_TRUE(map.Fuse(5, 0.6, 0.01, options));
+  // (0.01 * 0.5 + 0.04 * 0.6) / 0.05 = 0.58, 0.04 * 0.01 / 0.05 = 0.008 (float storage).
+  EXPECT_NEAR(map.idepth(5), 0.58, 1e-6);
+  EXPECT_NEAR(map.idepth_var(5), 0.008, 1e-8);
+  EXPECT_EQ(map.validity(5), options.validity_initial + options.validity_increment);
+  EXPECT_EQ(map.num_observations(5), 1);
+}
+
+TEST(SemiDenseDepthMapTest, OutliersDecreaseValidityAndInvalidate) {
+  SemiDenseDepthMap map(4, 4);
+  MappingOptions options;
+  map.Set(0, 0.5, 1e-4, 10);
+  // 0.1 away at sigma sqrt(2e-4) = 0.014: 7 sigma, beyond the 2-sigma gate.
+  EXPECT_FALSE(map.Fuse(0, 0.6, 1e-4, options));
+  EXPECT_TRUE(map.valid(0));
+  EXPECT_EQ(map.validity(0), 5);
+  EXPECT_FLOAT_EQ(map.idepth(0), 0.5f);
+  EXPECT_FALSE(map.Fuse(0, 0.6, 1e-4, options));
+  EXPECT_FALSE(map.valid(0));
+}
+
+TEST(SemiDenseDepthMapTest, RandomInitialisationIsDeterministicAndInRange) {
+  const cv::Mat image(40, 40, CV_8U, cv::Scalar(0));
+  cv::Mat textured = image.clone();
+  cv::randu(textured, 0, 255);
+  const ImagePyramid pyramid(textured, 1);
+  MappingOptions options;
+  SemiDenseDepthMap a(40, 40), b(40, 40);
+  a.SelectPixels(pyramid, cv::Mat(), options);
+  b.SelectPixels(pyramid, cv::Mat(), options);
+  a.InitializeRandom(0.2, 1.5, 1.0, 3, 20);
+  b.InitializeRandom(0.2, 1.5, 1.0, 3, 20);
+  ASSERT_GT(a.CountCandidates(), 100);
+  EXPECT_EQ(a.CountValid(), a.CountCandidates());
+  for (int i = 0; i < a.num_pixels(); ++i) {
+    if (!a.valid(i)) continue;
+    EXPECT_EQ(a.idepth(i), b.idepth(i));
+    EXPECT_GE(a.idepth(i), 0.2f);
+    EXPECT_LE(a.idepth(i), 1.5f);
+    EXPECT_EQ(a.num_observations(i), 0);
+  }
+  // Nothing within border_px of the border.
+  EXPECT_FALSE(a.candidate(a.Index(1, 20)));
+}
+
+TEST(EpipolarGeometryTest, ProjectionJacobianAndInverse) {
+  const PinholeCamera camera = TestCamera();
+  const SE3 cur_from_ref = SE3::Exp((Vector6d() << 0.1, -0.05, 0.03, 0.02, 0.05, -0.01).finished());
+  const EpipolarGeometry geometry(camera, cur_from_ref);
+  const Eigen::Vector2d pixel(50.0, 70.0);
+  const double idepth = 0.4;
+  Eigen::Vector2d projected;
+  ASSERT_TRUE(geometry.Project(pixel, idepth, &projected));
+  const Eigen::Vector3d point = cur_from_ref * (camera.Unproject(pixel) / idepth);
+  EXPECT_LT((projected - camera.Project(point)).norm(), 1e-9);
+  const double h = 1e-6;
+  Eigen::Vector2d plus, minus;
+  geometry.Project(pixel, idepth + h, &plus);
+  geometry.Project(pixel, idepth - h, &minus);
+  EXPECT_LT((geometry.IdepthJacobian(pixel, idepth) - (plus - minus) / (2 * h)).norm(), 1e-5);
+  EXPECT_NEAR(geometry.IdepthFromCurPixel(pixel, projected, plus - minus), idepth, 1e-9);
+}
+
+// A fronto-parallel textured plane at 2 m seen with a 10 cm sideways baseline: the SSD search
+// from a wide prior finds the true inverse depth within 3 sigma of its own variance.
+TEST(EpipolarStereoTest, SsdSearchFindsPlaneDepth) {
+  const PinholeCamera camera = TestCamera();
+  cv::Mat texture(camera.height + 60, camera.width + 60, CV_8U);
+  cv::RNG rng(7);
+  rng.fill(texture, cv::RNG::UNIFORM, 0, 255);
+  cv::GaussianBlur(texture, texture, cv::Size(5, 5), 1.2);
+  // Plane at z = 2: the current image (baseline +0.1 m in x) is the reference shifted by
+  // fx * 0.1 / 2 = 6.5 px to the left.
+  const double shift = camera.fx * 0.1 / 2.0;
+  cv::Mat ref_image = texture(cv::Rect(20, 20, camera.width, camera.height)).clone();
+  cv::Mat cur_image;
+  const cv::Mat warp = (cv::Mat_<double>(2, 3) << 1, 0, 20 + shift, 0, 1, 20);
+  cv::warpAffine(texture, cur_image, warp, cv::Size(camera.width, camera.height),
+                 cv::INTER_LINEAR | cv::WARP_INVERSE_MAP);
+  const ImagePyramid ref(ref_image, 1), cur(cur_image, 1);
+  const SE3 cur_from_ref(Eigen::Matrix3d::Identity(), Eigen::Vector3d(-0.1, 0.0, 0.0));
+  const EpipolarGeometry geometry(camera, cur_from_ref);
+  MappingOptions options;
+  int found = 0, consistent = 0;
+  for (int y = 20; y < 100; y += 7) {
+    for (int x = 30; x < 130; x += 7) {
+      const Eigen::Vector2d pixel(x, y);
+      EpipolarPatch patch;
+      if (MakeEpipolarPatch(ref, geometry, pixel, 0.5, options, &patch) != StereoStatus::kOk) {
+        continue;
+      }
+      StereoObservation observation;
+      if (SearchEpipolarSsd(cur, geometry, patch, pixel, 0.0, 2.0, options, &observation) !=
+          StereoStatus::kOk) {
+        continue;
+      }
+      ++found;
+      const double error = observation.idepth - 0.5;
+      consistent += error * error <= 9.0 * observation.idepth_var;
+    }
+  }
+  EXPECT_GT(found, 60);
+  // Random texture: a few ambiguous matches may remain; 90% must be within 3 sigma.
+  EXPECT_GT(consistent, 0.9 * found);
+}
+
+TEST(DepthPropagationTest, PlaneDepthIsPropagatedWithInflatedVariance) {
+  const PinholeCamera camera = TestCamera();
+  cv::Mat image(camera.height, camera.width, CV_8U);
+  cv::RNG rng(3);
+  rng.fill(image, cv::RNG::UNIFORM, 0, 255);
+  const ImagePyramid pyramid(image, 1);
+  MappingOptions options;
+  options.max_propagation_intensity_diff = 1e9;  // same image: no appearance check
+  SemiDenseDepthMap map(camera.width, camera.height);
+  map.SelectPixels(pyramid, cv::Mat(), options);
+  map.InitializeConstant(0.5, 1e-3, 20);
+  // Move 0.2 m forward: a fronto-parallel plane at 2 m is then at 1.8 m.
+  const SE3 new_from_old(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.0, 0.0, -0.2));
+  PropagationStats stats;
+  const SemiDenseDepthMap propagated =
+      PropagateDepthMap(map, pyramid, pyramid, cv::Mat(), camera, new_from_old, options, &stats);
+  ASSERT_GT(stats.propagated, 1000);
+  const double d1 = 1.0 / 1.8, jacobian = d1 * d1 / (0.5 * 0.5);
+  for (int i = 0; i < propagated.num_pixels(); ++i) {
+    if (!propagated.valid(i)) continue;
+    EXPECT_NEAR(propagated.idepth(i), d1, 1e-5);
+    // Collisions fuse compatible hypotheses, which can only lower the variance.
+    EXPECT_LE(propagated.idepth_var(i),
+              jacobian * jacobian * 1e-3 + options.propagation_var + 1e-9);
+  }
+}
+
+TEST(DepthMapIoTest, WritesPngAndPly) {
+  const PinholeCamera camera = TestCamera();
+  SemiDenseDepthMap map(camera.width, camera.height);
+  int expected = 0;
+  for (int y = 10; y < 20; ++y) {
+    for (int x = 10; x < 30; ++x) {
+      map.Set(map.Index(x, y), 0.2 + 0.01 * x, 0.01, 20);
+      if (x % 2 == 0) {
+        map.CountObservation(map.Index(x, y));  // only observed hypotheses go to the PLY
+        ++expected;
+      }
+    }
+  }
+  const std::string dir = ::testing::TempDir();
+  WriteInverseDepthPng(map, dir + "/pldvo_idepth.png");
+  const cv::Mat png = cv::imread(dir + "/pldvo_idepth.png", cv::IMREAD_COLOR);
+  ASSERT_EQ(png.rows, camera.height);
+  EXPECT_EQ(png.at<cv::Vec3b>(0, 0), cv::Vec3b(0, 0, 0));  // invalid: black
+  EXPECT_NE(png.at<cv::Vec3b>(15, 20), cv::Vec3b(0, 0, 0));
+  const cv::Mat image(camera.height, camera.width, CV_8U, cv::Scalar(100));
+  EXPECT_EQ(WritePointCloudPly(map, image, camera, SE3(), dir + "/pldvo_points.ply"), expected);
+  std::ifstream ply(dir + "/pldvo_points.ply");
+  std::string line;
+  int vertices = -1, data_lines = 0;
+  bool header = true;
+  while (std::getline(ply, line)) {
+    if (header) {
+      std::sscanf(line.c_str(), "element vertex %d", &vertices);
+      header = line != "end_header";
+    } else {
+      ++data_lines;
+    }
+  }
+  EXPECT_EQ(vertices, expected);
+  EXPECT_EQ(data_lines, expected);
+  EXPECT_THROW(WriteInverseDepthPng(map, "/nonexistent_dir/x.png"), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace pldvo

@@ -1,0 +1,222 @@
+// `pldvo run` and `pldvo ablate` end to end through the real binary (PLDVO_BINARY) on a tiny
+// synthetic sequence written in the TUM layout (320x240, 36 frames): every output file, the
+// survival of the trajectory across a corrupt frame mid-run, the ablation tables and plot, and
+// the rejection of an unknown config key. Runs use the deterministic single-thread mapping.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "backend/odometry_config.h"
+#include "core/config_io.h"
+#include "core/synthetic/synthetic_sequence.h"
+#include "core/trajectory_io.h"
+
+namespace pldvo {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr int kFrames = 36;  // 1.2 s: RPE needs pairs 1 s apart
+
+fs::path TestRoot() {
+  static const fs::path root = [] {
+    const fs::path dir =
+        fs::temp_directory_path() / ("pldvo_run_command_test_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+  }();
+  return root;
+}
+
+// Removes the test's temporary folder when the test process ends.
+class RemoveTestRoot : public ::testing::Environment {
+ public:
+  void TearDown() override { fs::remove_all(TestRoot()); }
+};
+[[maybe_unused]] ::testing::Environment* const kRemoveTestRoot =
+    ::testing::AddGlobalTestEnvironment(new RemoveTestRoot);
+
+// The synthetic sequence (written once per test process).
+fs::path SequenceDir() {
+  static const fs::path dir = [] {
+    synthetic::SynthOptions options;
+    options.preset = "lowtex";
+    options.frames = kFrames;
+    options.seed = 1;
+    options.width = 320;
+    options.height = 240;
+    options.fx = options.fy = 262.5;
+    options.threads = 2;
+    const fs::path path = TestRoot() / "lowtex";
+    synthetic::WriteSequence(synthetic::MakeSequence(options), path.string());
+    return path;
+  }();
+  return dir;
+}
+
+std::string Slurp(const fs::path& path) {
+  std::ifstream file(path);
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+int CountLines(const fs::path& path, bool skip_comments) {
+  std::ifstream file(path);
+  std::string line;
+  int count = 0;
+  while (std::getline(file, line)) {
+    if (line.empty() || (skip_comments && line[0] == '#')) continue;
+    ++count;
+  }
+  return count;
+}
+
+// Runs the pldvo binary with `args`; stdout and stderr go to `log`. Returns the exit code.
+int Pldvo(const std::string& args, const fs::path& log) {
+  const std::string command =
+      std::string(PLDVO_BINARY) + " " + args + " > " + log.string() + " 2>&1";
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+const char* const kDeterministic = " --set odometry.parallel_mapping=false";
+
+TEST(RunCommandTest, WritesAllOutputs) {
+  const fs::path out = TestRoot() / "run_all";
+  ASSERT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " + out.string() +
+                      kDeterministic + " --set output.keyframe_depth_png=true" +
+                      " --set output.keyframe_ply=true --set output.iteration_images_every=10",
+                  TestRoot() / "run_all.log"),
+            0)
+      << Slurp(TestRoot() / "run_all.log");
+  // trajectory.txt: one TUM line per tracked frame (all of them on this sequence).
+  const Trajectory trajectory = ReadTrajectoryTum((out / "trajectory.txt").string());
+  EXPECT_EQ(trajectory.size(), static_cast<size_t>(kFrames));
+  // timing.csv: a header and one row per frame.
+  EXPECT_EQ(CountLines(out / "timing.csv", false), kFrames + 1);
+  // config.yaml: the effective config, loadable, with the override applied.
+  OdometryConfig config;
+  ASSERT_NO_THROW(LoadConfigYaml((out / "config.yaml").string(), &config));
+  EXPECT_FALSE(config.odometry.parallel_mapping);
+  // summary.json: counts, timing objects and the evaluation against the ground truth.
+  const nlohmann::json summary = nlohmann::json::parse(Slurp(out / "summary.json"));
+  EXPECT_EQ(summary["frames"], kFrames);
+  EXPECT_EQ(summary["tracked"], kFrames);
+  EXPECT_GE(summary["keyframes"].get<int>(), 1);
+  EXPECT_EQ(summary["lost_events"], 0);
+  for (const char* object : {"ms_median", "ms_mean"}) {
+    for (const char* key : {"detection", "description", "matching", "tracking", "mapping",
+                            "tracking_thread", "total"}) {
+      ASSERT_TRUE(summary[object].contains(key)) << object << "." << key;
+      EXPECT_GE(summary[object][key].get<double>(), 0.0);
+    }
+  }
+  for (const char* key : {"rpe_cm_s", "rpe_deg_s", "ate_m", "coverage"}) {
+    EXPECT_TRUE(summary[key].is_number()) << key;
+  }
+  // Coverage: all frames; timestamps in rgb.txt carry 6 decimals, hence not exactly 1.
+  EXPECT_NEAR(summary["coverage"].get<double>(), 1.0, 1e-3);
+  // Optional outputs: keyframe PNG and PLY, iteration images of frames 10 and 20.
+  EXPECT_TRUE(fs::exists(out / "keyframes" / "kf_0000_idepth.png"));
+  EXPECT_TRUE(fs::exists(out / "keyframes" / "kf_0000.ply"));
+  int iteration_images = 0;
+  for (const auto& entry : fs::directory_iterator(out / "iterations")) {
+    iteration_images += entry.path().extension() == ".png";
+  }
+  EXPECT_GT(iteration_images, 2);
+}
+
+TEST(RunCommandTest, CorruptFrameIsSkippedAndTheTrajectorySurvives) {
+  // A copy of the sequence with frame 12's PNG replaced by garbage.
+  const fs::path dataset = TestRoot() / "corrupt";
+  fs::remove_all(dataset);
+  fs::copy(SequenceDir(), dataset, fs::copy_options::recursive);
+  std::vector<fs::path> images;
+  for (const auto& entry : fs::directory_iterator(dataset / "rgb")) images.push_back(entry.path());
+  std::sort(images.begin(), images.end());
+  ASSERT_EQ(images.size(), static_cast<size_t>(kFrames));
+  const fs::path broken = images[12];
+  {
+    std::ofstream file(broken, std::ios::trunc);
+    file << "not a png";
+  }
+  const fs::path out = TestRoot() / "run_corrupt";
+  const fs::path log = TestRoot() / "run_corrupt.log";
+  ASSERT_EQ(
+      Pldvo("run --dataset " + dataset.string() + " --out " + out.string() + kDeterministic, log),
+      0)
+      << Slurp(log);
+  // The failure names the frame and its file; the run went on.
+  const std::string text = Slurp(log);
+  EXPECT_NE(text.find("frame 12"), std::string::npos) << text;
+  EXPECT_NE(text.find(broken.filename().string()), std::string::npos) << text;
+  // Every other frame is in the trajectory (tracking recovers right after the skipped frame).
+  const Trajectory trajectory = ReadTrajectoryTum((out / "trajectory.txt").string());
+  EXPECT_EQ(trajectory.size(), static_cast<size_t>(kFrames - 1));
+  const std::string timing = Slurp(out / "timing.csv");
+  EXPECT_NE(timing.find("\n12,"), std::string::npos);
+  EXPECT_NE(timing.find(",failed,"), std::string::npos);
+  const nlohmann::json summary = nlohmann::json::parse(Slurp(out / "summary.json"));
+  EXPECT_EQ(summary["failed_frames"], 1);
+  EXPECT_EQ(summary["lost_events"], 1);
+}
+
+TEST(RunCommandTest, UnknownConfigKeyIsAnError) {
+  const fs::path log = TestRoot() / "run_bad_key.log";
+  EXPECT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " +
+                      (TestRoot() / "run_bad_key").string() + " --set keyframes.min_overlapp=0.5",
+                  log),
+            2);
+  EXPECT_NE(Slurp(log).find("keyframes.min_overlapp"), std::string::npos) << Slurp(log);
+  EXPECT_FALSE(fs::exists(TestRoot() / "run_bad_key" / "trajectory.txt"));
+}
+
+TEST(AblateCommandTest, TinyGridWritesTablesAndPlot) {
+  const fs::path configs = fs::path(PLDVO_SOURCE_DIR) / "experiments" / "configs";
+  const fs::path out = TestRoot() / "ablate";
+  const fs::path log = TestRoot() / "ablate.log";
+  ASSERT_EQ(
+      Pldvo("ablate --configs " + (configs / "sdvo.yaml").string() + "," +
+                (configs / "points_lines.yaml").string() + " --datasets " + SequenceDir().string() +
+                " --out " + out.string() + " --jobs 2" + kDeterministic,
+            log),
+      0)
+      << Slurp(log);
+  // results.csv: header + one row per pair, both evaluated.
+  EXPECT_EQ(CountLines(out / "results.csv", false), 3);
+  const std::string csv = Slurp(out / "results.csv");
+  EXPECT_NE(csv.find("lowtex,sdvo,ok,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("lowtex,points_lines,ok,"), std::string::npos) << csv;
+  // results.md: the RPE table with one row for the sequence and a column per config.
+  const std::string md = Slurp(out / "results.md");
+  EXPECT_NE(md.find("| sequence | sdvo | points_lines |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| lowtex |"), std::string::npos) << md;
+  // The trajectory plot: an SVG with the ground truth and one polyline per config.
+  const std::string svg = Slurp(out / "trajectories_lowtex.svg");
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+  size_t polylines = 0;
+  for (size_t pos = svg.find("<polyline"); pos != std::string::npos;
+       pos = svg.find("<polyline", pos + 1)) {
+    ++polylines;
+  }
+  EXPECT_EQ(polylines, 3u);
+  // A grid with a missing dataset: that run fails and shows as X, the command exits 1.
+  const fs::path out2 = TestRoot() / "ablate_missing";
+  EXPECT_EQ(Pldvo("ablate --configs " + (configs / "sdvo.yaml").string() + " --datasets " +
+                      (TestRoot() / "no_such_dataset").string() + " --out " + out2.string(),
+                  TestRoot() / "ablate_missing.log"),
+            1);
+  EXPECT_NE(Slurp(out2 / "results.md").find("| no_such_dataset | X |"), std::string::npos)
+      << Slurp(out2 / "results.md");
+}
+
+}  // namespace
+}  // namespace pldvo

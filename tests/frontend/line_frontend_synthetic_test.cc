@@ -1,0 +1,276 @@
+// The line frontend against ground truth on the synthetic `lowtex` preset (acceptance numbers
+// of the line-frontend issue): detection recall, fragmentation before/after merging, match
+// precision and recall for frame gaps 1, 5 and 10 (with and without a predicted position) and
+// edge tracing on real keyframe lines. Two scenes (seeds 1 and 3) x two keyframes (0, 25) x
+// gaps {1, 5, 10}: 16 rendered frames. Ground truth: tests/frontend/line_ground_truth.h.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <functional>
+#include <map>
+#include <memory>
+#include <set>
+
+#include "core/synthetic/synthetic_sequence.h"
+#include "frontend/line_frontend.h"
+#include "tests/frontend/line_ground_truth.h"
+
+namespace pldvo {
+namespace {
+
+using test::GtPiece;
+using test::MatchOutcome;
+
+constexpr double kDistancePx = 2.0;               // "within ~2 px"
+constexpr double kAngleRad = 5.0 * M_PI / 180.0;  // "and ~5 deg"
+constexpr double kMinGtLengthPx = 40.0;           // GT edges longer than 40 px count
+const int kSeeds[] = {1, 3};
+const int kKeyframes[] = {0, 25};
+const int kGaps[] = {1, 5, 10};
+
+struct FrameData {
+  SE3 world_from_cam;
+  synthetic::RenderedFrame rendered;
+  std::vector<GtPiece> pieces;  // all visible pieces (any length)
+  LineFrame lines;
+  std::vector<LineSegment> unmerged;  // detector output, length-filtered, not merged
+  std::vector<int> edge_of_segment;   // AssociateSegment of lines.segments
+};
+
+struct SceneData {
+  synthetic::SyntheticSequence sequence;
+  std::map<int, FrameData> frames;
+};
+
+// Rendered and processed once for all tests of the suite.
+std::vector<SceneData>* g_scenes = nullptr;
+
+class LineFrontendSynthetic : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    g_scenes = new std::vector<SceneData>();
+    LineFrontendOptions options;
+    LineFrontend frontend(options);
+    LineDetector detector(options.detector);
+    LineMergerOptions no_merge = options.merger;
+    no_merge.enabled = false;
+    const LineMerger filter(no_merge, options.detector.endpoint_sigma_px);
+    for (int seed : kSeeds) {
+      synthetic::SynthOptions synth;
+      synth.preset = "lowtex";
+      synth.seed = seed;
+      synth.frames = 40;
+      SceneData scene{synthetic::MakeSequence(synth), {}};
+      for (int keyframe : kKeyframes) {
+        for (int gap : {0, 1, 5, 10}) {
+          const int index = keyframe + gap;
+          FrameData& f = scene.frames[index];
+          f.world_from_cam = scene.sequence.ground_truth[index].world_from_cam;
+          f.rendered = synthetic::RenderFrame(scene.sequence, index);
+          f.pieces = test::VisibleEdgePieces(scene.sequence, f.world_from_cam, f.rendered, 0.0);
+          f.lines = frontend.Process(f.rendered.image);
+          const int num_octaves = options.detector.first_octave + options.detector.num_octaves;
+          f.unmerged = filter.Merge(detector.Detect(BuildOctaves(f.rendered.image, num_octaves)));
+          for (const LineSegment& s : f.lines.segments) {
+            f.edge_of_segment.push_back(
+                test::AssociateSegment(s, f.pieces, kDistancePx, kAngleRad, 0.8));
+          }
+        }
+      }
+      g_scenes->push_back(std::move(scene));
+    }
+  }
+  static void TearDownTestSuite() {
+    delete g_scenes;
+    g_scenes = nullptr;
+  }
+  // The GT pieces every test counts: long enough and with visible contrast.
+  static bool Counted(const GtPiece& piece) {
+    return piece.length() >= kMinGtLengthPx && piece.contrast >= test::kMinContrast;
+  }
+};
+
+TEST_F(LineFrontendSynthetic, DetectionRecall) {
+  int detected = 0, total = 0;
+  for (const SceneData& scene : *g_scenes) {
+    for (const auto& [index, f] : scene.frames) {
+      for (const GtPiece& piece : f.pieces) {
+        if (!Counted(piece)) continue;
+        ++total;
+        // Detected: segments within 2 px and 5 deg cover most (>= half) of the GT piece.
+        if (test::Coverage(piece, f.lines.segments, kDistancePx, kAngleRad) >= 0.5) ++detected;
+      }
+    }
+  }
+  const double recall = static_cast<double>(detected) / total;
+  std::printf("detection recall %.3f (%d of %d visible GT edges >= 40 px)\n", recall, detected,
+              total);
+  ASSERT_GT(total, 500);
+  EXPECT_GE(recall, 0.90);
+}
+
+TEST_F(LineFrontendSynthetic, MergingReducesFragmentation) {
+  // Segments lying on a GT piece (>= 80% of their samples within 2 px and 5 deg), per GT piece
+  // that has at least one, before (detector output on both octaves, same length filter) and
+  // after merging.
+  double before = 0.0, after = 0.0;
+  int pieces = 0;
+  for (const SceneData& scene : *g_scenes) {
+    for (const auto& [index, f] : scene.frames) {
+      for (const GtPiece& piece : f.pieces) {
+        if (!Counted(piece)) continue;
+        const std::vector<GtPiece> one = {piece};
+        int n_before = 0, n_after = 0;
+        for (const LineSegment& s : f.unmerged) {
+          n_before += test::AssociateSegment(s, one, kDistancePx, kAngleRad, 0.8) >= 0;
+        }
+        for (const LineSegment& s : f.lines.segments) {
+          n_after += test::AssociateSegment(s, one, kDistancePx, kAngleRad, 0.8) >= 0;
+        }
+        if (n_before == 0) continue;
+        before += n_before;
+        after += n_after;
+        ++pieces;
+      }
+    }
+  }
+  before /= pieces;
+  after /= pieces;
+  std::printf("segments per GT edge: %.2f before merging, %.2f after (%d edges)\n", before, after,
+              pieces);
+  // Two octaves report most edges twice, so unmerged fragmentation is near or above 2; a
+  // merger doing its job leaves close to one segment per edge.
+  EXPECT_LT(after, 0.7 * before);
+  EXPECT_LT(after, 1.3);
+}
+
+struct MatchStats {
+  int correct = 0, wrong = 0, unverifiable = 0;
+  int matchable = 0, matchable_matched = 0;
+  double precision() const { return static_cast<double>(correct) / (correct + wrong); }
+  double recall() const { return static_cast<double>(matchable_matched) / matchable; }
+};
+
+// Matches keyframe -> keyframe + gap and scores them. A reference segment is matchable when
+// some current segment lies on the same scene edge (test::JudgeMatch); recall counts the
+// matchable ones that received a correct match. Unverifiable matches (neither segment on a
+// scene edge) are excluded from the precision and reported.
+MatchStats EvaluateMatches(const SceneData& scene, int keyframe, int gap,
+                           const SegmentPredictor& predictor) {
+  LineFrontend frontend{LineFrontendOptions()};
+  const FrameData& ref = scene.frames.at(keyframe);
+  const FrameData& cur = scene.frames.at(keyframe + gap);
+  auto judge = [&](int r, int c) {
+    return test::JudgeMatch(scene.sequence, ref.lines.segments[r], ref.world_from_cam,
+                            ref.edge_of_segment[r], cur.lines.segments[c], cur.world_from_cam,
+                            cur.edge_of_segment[c]);
+  };
+  MatchStats stats;
+  std::vector<char> matchable(ref.lines.segments.size(), 0);
+  for (size_t r = 0; r < ref.lines.segments.size(); ++r) {
+    for (size_t c = 0; c < cur.lines.segments.size() && !matchable[r]; ++c) {
+      matchable[r] = judge(r, c) == MatchOutcome::kCorrect;
+    }
+    stats.matchable += matchable[r];
+  }
+  for (const LineMatch& m : frontend.Match(ref.lines, cur.lines, predictor)) {
+    const MatchOutcome outcome = judge(m.ref_index, m.cur_index);
+    stats.correct += outcome == MatchOutcome::kCorrect;
+    stats.wrong += outcome == MatchOutcome::kWrong;
+    stats.unverifiable += outcome == MatchOutcome::kUnverifiable;
+    stats.matchable_matched += outcome == MatchOutcome::kCorrect && matchable[m.ref_index];
+  }
+  return stats;
+}
+
+void ExpectMatchTargets(const std::function<SegmentPredictor(const SceneData&, int, int)>& make,
+                        const char* label) {
+  for (int gap : kGaps) {
+    MatchStats total;
+    for (const SceneData& scene : *g_scenes) {
+      for (int keyframe : kKeyframes) {
+        const MatchStats s = EvaluateMatches(scene, keyframe, gap, make(scene, keyframe, gap));
+        total.correct += s.correct;
+        total.wrong += s.wrong;
+        total.unverifiable += s.unverifiable;
+        total.matchable += s.matchable;
+        total.matchable_matched += s.matchable_matched;
+      }
+    }
+    std::printf("%s gap %2d: %d correct, %d wrong, %d unverifiable; precision %.3f recall %.3f\n",
+                label, gap, total.correct, total.wrong, total.unverifiable, total.precision(),
+                total.recall());
+    EXPECT_GE(total.precision(), 0.95) << label << " gap " << gap;
+    EXPECT_GE(total.recall(), 0.70) << label << " gap " << gap;
+  }
+}
+
+TEST_F(LineFrontendSynthetic, MatchPrecisionRecallWithoutPrediction) {
+  ExpectMatchTargets([](const SceneData&, int, int) { return SegmentPredictor(); },
+                     "no prediction");
+}
+
+// The prediction a tracker provides: the ground-truth relative pose and the keyframe's depth
+// (the smallest rendered depth in a 5x5 window around each endpoint, i.e. the occluding side
+// of a depth edge, which is the side a line's 3D points lie on).
+TEST_F(LineFrontendSynthetic, MatchPrecisionRecallWithPredictedPosition) {
+  ExpectMatchTargets(
+      [](const SceneData& scene, int keyframe, int gap) -> SegmentPredictor {
+        const FrameData& ref = scene.frames.at(keyframe);
+        const SE3 cur_from_ref =
+            scene.frames.at(keyframe + gap).world_from_cam.Inverse() * ref.world_from_cam;
+        const PinholeCamera camera = scene.sequence.camera;
+        const cv::Mat depth = ref.rendered.depth;
+        auto predict_point = [=](const Eigen::Vector2d& p, Eigen::Vector2d* q) {
+          float z = 0.f;
+          const int x0 = static_cast<int>(std::lround(p.x()));
+          const int y0 = static_cast<int>(std::lround(p.y()));
+          for (int y = std::max(0, y0 - 2); y <= std::min(depth.rows - 1, y0 + 2); ++y) {
+            for (int x = std::max(0, x0 - 2); x <= std::min(depth.cols - 1, x0 + 2); ++x) {
+              const float d = depth.at<float>(y, x);
+              if (d > 0.f && (z == 0.f || d < z)) z = d;
+            }
+          }
+          if (z <= 0.f) return false;
+          const Eigen::Vector3d point_in_cur = cur_from_ref * (z * camera.Unproject(p));
+          if (point_in_cur.z() <= 0.05) return false;
+          *q = camera.Project(point_in_cur);
+          return true;
+        };
+        return [=](const LineSegment& s, Eigen::Vector2d* start, Eigen::Vector2d* end) {
+          return predict_point(s.start, start) && predict_point(s.end, end);
+        };
+      },
+      "predicted");
+}
+
+TEST_F(LineFrontendSynthetic, EdgeTracingOfMatchedKeyframeLines) {
+  LineFrontend frontend{LineFrontendOptions()};
+  for (const SceneData& scene : *g_scenes) {
+    const FrameData& ref = scene.frames.at(0);
+    const std::vector<LineMatch> matches = frontend.Match(ref.lines, scene.frames.at(5).lines);
+    const EdgeTrace trace = frontend.TraceMatched(ref.lines, matches);
+    ASSERT_FALSE(trace.lines.empty());
+    std::set<int> matched;
+    for (const LineMatch& m : matches) matched.insert(m.ref_index);
+    EXPECT_EQ(trace.lines.size(), matched.size());
+    int traced = 0;
+    for (const TracedLine& line : trace.lines) {
+      EXPECT_EQ(matched.count(line.id), 1u);
+      EXPECT_EQ(line.segment.line, ref.lines.segments[line.id].line);
+      for (const Eigen::Vector2i& p : line.pixels) {
+        const Eigen::Vector2d q = p.cast<double>();
+        const LineSegment& s = line.segment;
+        const double t = std::clamp(s.Project(q), 0.0, s.length);
+        // Rounding (0.5 px) plus the one-pixel widening (edge_tracer.h).
+        EXPECT_LE((s.start + t * s.direction() - q).norm(), 1.5 + 1e-9);
+        EXPECT_EQ(trace.id_map.at<int>(p.y(), p.x()), line.id);
+      }
+      traced += static_cast<int>(line.pixels.size());
+    }
+    EXPECT_EQ(cv::countNonZero(trace.id_map >= 0), traced);
+  }
+}
+
+}  // namespace
+}  // namespace pldvo
