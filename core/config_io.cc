@@ -432,6 +432,9 @@ void OpenYamlForReading(const std::string& path, cv::FileStorage* storage) {
                                ": YAML syntax error: " + rest);
     }
     throw std::runtime_error(path + ": YAML syntax error: " + error.err + " " + message);
+  } catch (const std::exception& error) {
+    // OpenCV 4.6's parser also lets std::length_error out (an empty key "  :" in a nested map).
+    throw std::runtime_error(path + ": YAML syntax error: " + error.what());
   }
   if (!storage->isOpened()) throw std::runtime_error(path + ": cannot parse the file as YAML");
 }

@@ -97,6 +97,15 @@ TEST_F(ParserRegressionTest, YamlSpellingsNextToTheGuardStillRead) {
   }
 }
 
+// An empty key in a nested map made cv::FileStorage throw std::length_error
+// ("basic_string::_M_create"), which escaped without the file name (config_fuzzer).
+TEST_F(ParserRegressionTest, EmptyNestedKeyIsAYamlErrorNamingTheFile) {
+  const std::string path = Write("config.yaml", "%YAML:1.0\n---\nname:\n   ...x: 1\n   :\n");
+  StringOptions options;
+  const std::string error = ErrorOf([&] { LoadConfigYaml(path, &options); });
+  EXPECT_THAT(error, HasSubstr(path + ": YAML syntax error"));
+}
+
 // WriteCameraYaml spelled cx = 19444444444444444.2 as "19444444444444444", which
 // cv::FileStorage reads as a wrapped int (camera_yaml_fuzzer: the round trip broke).
 TEST_F(ParserRegressionTest, CameraYamlWritesLargeValuesAsReals) {
