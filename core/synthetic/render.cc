@@ -7,8 +7,8 @@
 // rounded and clamped to [0, 255], with V(r) = 1 - s (r / r_corner)^2 the vignetting.
 // Pass 1 casts one ray through each pixel centre and records the surface (primitive, face) and
 // z-depth; pass 2 re-renders pixels whose 8-neighbourhood holds another surface with n x n
-// sub-pixel rays (anti-aliasing). Each 16x16 tile only tests the primitives whose bounding
-// sphere meets the tile's frustum.
+// sub-pixel rays (anti-aliasing). Each 16x16 tile only tests the boxes that meet the tile's
+// frustum, and each supersampled pixel only those of the tile that meet the pixel's frustum.
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -67,9 +67,15 @@ class Renderer {
         tiles_x_((camera.width + kTile - 1) / kTile),
         tiles_y_((camera.height + kTile - 1) / kTile) {
     const auto& primitives = scene.primitives();
-    for (const Primitive& p : primitives) {
-      bound_center_.push_back(p.center_in_world);
-      bound_radius_.push_back(p.half_size.norm() + 1e-6);
+    all_primitives_.resize(primitives.size());
+    for (size_t p = 0; p < primitives.size(); ++p) {
+      all_primitives_[p] = static_cast<int>(p);
+      Eigen::Matrix3d half_axes;  // columns: the box axes in the world, times the half sizes
+      for (int a = 0; a < 3; ++a) {
+        half_axes.col(a) =
+            primitives[p].box_from_world_rotation.row(a).transpose() * primitives[p].half_size[a];
+      }
+      half_axes_.push_back(half_axes);
     }
   }
 
@@ -83,9 +89,10 @@ class Renderer {
     // Pass 1: pixel centres.
     ParallelFor(tile_count, threads_, [&](int tile) {
       std::vector<int> candidates;
-      TileCandidates(tile, rotation, origin, &candidates);
       int x0, y0, x1, y1;
       TileRange(tile, &x0, &y0, &x1, &y1);
+      FrustumCandidates(x0 - 0.5, y0 - 0.5, x1 - 0.5, y1 - 0.5, rotation, origin, all_primitives_,
+                        &candidates);
       for (int y = y0; y < y1; ++y) {
         for (int x = x0; x < x1; ++x) {
           const int i = y * camera_.width + x;
@@ -108,7 +115,7 @@ class Renderer {
     // Pass 2: supersample pixels on surface boundaries.
     const int w = camera_.width, h = camera_.height, ss = supersampling_;
     ParallelFor(tile_count, threads_, [&](int tile) {
-      std::vector<int> candidates;
+      std::vector<int> candidates, pixel_candidates;
       bool have_candidates = false;
       int x0, y0, x1, y1;
       TileRange(tile, &x0, &y0, &x1, &y1);
@@ -128,17 +135,21 @@ class Renderer {
           }
           if (!boundary) continue;
           if (!have_candidates) {
-            TileCandidates(tile, rotation, origin, &candidates);
+            FrustumCandidates(x0 - 0.5, y0 - 0.5, x1 - 0.5, y1 - 0.5, rotation, origin,
+                              all_primitives_, &candidates);
             have_candidates = true;
           }
+          // The sub-pixel rays only test what the pixel's own frustum can hold.
+          FrustumCandidates(x - 0.5, y - 0.5, x + 0.5, y + 0.5, rotation, origin, candidates,
+                            &pixel_candidates);
           double sum = 0.0;
           for (int sy = 0; sy < ss; ++sy) {
             for (int sx = 0; sx < ss; ++sx) {
               const Eigen::Vector2d pixel(x - 0.5 + (sx + 0.5) / ss, y - 0.5 + (sy + 0.5) / ss);
               const Eigen::Vector3d direction = rotation * camera_.Unproject(pixel);
               Scene::Hit hit;
-              if (scene_.IntersectSubset(origin, direction, candidates.data(),
-                                         static_cast<int>(candidates.size()), &hit)) {
+              if (scene_.IntersectSubset(origin, direction, pixel_candidates.data(),
+                                         static_cast<int>(pixel_candidates.size()), &hit)) {
                 sum += Shade(hit, origin, direction);
               }
             }
@@ -159,12 +170,13 @@ class Renderer {
     *y1 = std::min(*y0 + kTile, camera_.height);
   }
 
-  // Primitives whose bounding sphere meets the frustum of the tile's pixel area.
-  void TileCandidates(int tile, const Eigen::Matrix3d& rotation, const Eigen::Vector3d& origin,
-                      std::vector<int>* candidates) const {
-    int x0, y0, x1, y1;
-    TileRange(tile, &x0, &y0, &x1, &y1);
-    const double u0 = x0 - 0.5, u1 = x1 - 0.5, v0 = y0 - 0.5, v1 = y1 - 0.5;
+  // The primitives of `from` that may meet the frustum through the image rectangle
+  // [u0, u1] x [v0, v1]: a box is dropped when it lies entirely outside one of the frustum's
+  // four side planes (box-plane separation with the box's projected radius, exact for boxes).
+  // The room encloses the camera and is always kept.
+  void FrustumCandidates(double u0, double v0, double u1, double v1,
+                         const Eigen::Matrix3d& rotation, const Eigen::Vector3d& origin,
+                         const std::vector<int>& from, std::vector<int>* candidates) const {
     const Eigen::Vector3d corner[4] = {rotation * camera_.Unproject(Eigen::Vector2d(u0, v0)),
                                        rotation * camera_.Unproject(Eigen::Vector2d(u1, v0)),
                                        rotation * camera_.Unproject(Eigen::Vector2d(u1, v1)),
@@ -172,20 +184,21 @@ class Renderer {
     const Eigen::Vector3d inside = corner[0] + corner[1] + corner[2] + corner[3];
     Eigen::Vector3d normal[4];
     for (int k = 0; k < 4; ++k) {
-      normal[k] = corner[k].cross(corner[(k + 1) % 4]).normalized();
+      normal[k] = corner[k].cross(corner[(k + 1) % 4]);
       if (normal[k].dot(inside) < 0.0) normal[k] = -normal[k];
     }
     candidates->clear();
     const auto& primitives = scene_.primitives();
-    for (int p = 0; p < static_cast<int>(primitives.size()); ++p) {
+    for (const int p : from) {
       if (primitives[p].kind == Primitive::Kind::kRoom) {
         candidates->push_back(p);
         continue;
       }
-      const Eigen::Vector3d offset = bound_center_[p] - origin;
+      const Eigen::Vector3d offset = primitives[p].center_in_world - origin;
       bool outside = false;
       for (int k = 0; k < 4 && !outside; ++k) {
-        outside = normal[k].dot(offset) < -bound_radius_[p];
+        const double radius = (normal[k].transpose() * half_axes_[p]).cwiseAbs().sum();
+        outside = normal[k].dot(offset) < -radius * (1.0 + 1e-9) - 1e-12;
       }
       if (!outside) candidates->push_back(p);
     }
@@ -209,8 +222,8 @@ class Renderer {
   int supersampling_;
   int threads_;
   int tiles_x_, tiles_y_;
-  std::vector<Eigen::Vector3d> bound_center_;
-  std::vector<double> bound_radius_;
+  std::vector<int> all_primitives_;
+  std::vector<Eigen::Matrix3d> half_axes_;
 };
 
 ShadingParams MakeShading(const SyntheticSequence& sequence, const Lighting& lighting) {

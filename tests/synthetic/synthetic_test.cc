@@ -299,7 +299,7 @@ TEST(SyntheticTest, TrajectoryStaysInsideTheRoomAndSeesStructure) {
       const SyntheticSequence sequence = MakeSequence(options);
       ASSERT_EQ(sequence.ground_truth.size(), 300u);
       const Eigen::Vector3d& room = sequence.scene.room_size();
-      double min_valid = 1.0;
+      double min_valid = 1.0, min_structure = 1.0;
       for (int index = 0; index < options.frames; ++index) {
         const Eigen::Vector3d position = sequence.ground_truth[index].world_from_cam.translation();
         for (int axis = 0; axis < 3; ++axis) {
@@ -315,9 +315,16 @@ TEST(SyntheticTest, TrajectoryStaysInsideTheRoomAndSeesStructure) {
         double min_depth = 0.0;
         cv::minMaxLoc(frame.depth, &min_depth, nullptr, nullptr, nullptr, frame.depth > 0.0f);
         EXPECT_GE(min_depth, 0.9 * options.min_depth) << preset << " seed " << seed;
+        // Structure in view: pixels with |grad| > 4 gray levels/px (noise sigma 1 alone gives a
+        // Rayleigh scale of 0.43, so > 4 is a 9-sigma event) are surface boundaries.
+        const double structure =
+            HighGradientPixels(frame.image, 4.0) / static_cast<double>(frame.image.total());
+        min_structure = std::min(min_structure, structure);
       }
       std::cout << preset << " seed " << seed << ": min fraction of valid depth " << min_valid
-                << "\n";
+                << ", min fraction of edge pixels " << min_structure << "\n";
+      // At least 1% of the pixels (192 at 160x120, a line across the image) are on edges.
+      EXPECT_GE(min_structure, 0.01) << preset << " seed " << seed;
       // A closed room: every ray hits something.
       EXPECT_GE(min_valid, 0.99) << preset << " seed " << seed;
     }
