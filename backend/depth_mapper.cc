@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 #include <string>
 
@@ -105,6 +106,17 @@ void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
                               patch_status == StereoStatus::kOk ? &patch : nullptr, &observation);
     if (status == StereoStatus::kOk) {
       ++stats->line_ok;
+      if (options_.line_stereo_refine_ssd && patch_status == StereoStatus::kOk) {
+        const double range = options_.search_sigmas * std::sqrt(observation.idepth_var);
+        StereoObservation refined;
+        if (SearchEpipolarSsd(current, geometry, patch, pixel,
+                              std::max(idepth_min, observation.idepth - range),
+                              std::min(idepth_max, observation.idepth + range), options_,
+                              &refined) == StereoStatus::kOk) {
+          observation = refined;
+          ++stats->line_refined;
+        }
+      }
     } else if (status == StereoStatus::kLineIllConditioned) {
       ++stats->line_fallback;
     } else {
@@ -162,6 +174,33 @@ FrameUpdateStats DepthMapper::UpdateWithFrame(const cv::Mat& image, const SE3& c
   if (options_.regularize) {
     stats.removed = RemoveIsolatedHypotheses(options_, &map_);
     stats.filled = FillHoles(options_, &map_);
+  }
+  return stats;
+}
+
+LineDepthFusionStats DepthMapper::FuseLineDepths(const std::vector<KeyframeLine>& lines) {
+  LineDepthFusionStats stats;
+  std::map<int, const KeyframeLine*> line_of_edge;
+  for (const KeyframeLine& line : lines) line_of_edge[line.edge_id] = &line;
+  const double max_miss_ratio = kLineDepthMissPx / std::max(camera_.fx, camera_.fy);
+  for (int i = 0; i < map_.num_pixels(); ++i) {
+    if (!map_.valid(i) || map_.edge_id(i) < 0) continue;
+    const auto it = line_of_edge.find(map_.edge_id(i));
+    if (it == line_of_edge.end()) continue;
+    ++stats.pixels;
+    const Eigen::Vector2d pixel(i % map_.width(), i / map_.width());
+    double idepth, idepth_var;
+    if (!RayLineInverseDepthAndVariance(camera_, pixel, *it->second, max_miss_ratio, &idepth,
+                                        &idepth_var) ||
+        !(idepth_var > 0.0)) {
+      ++stats.skipped;
+      continue;
+    }
+    if (map_.Fuse(i, idepth, idepth_var, options_)) {
+      ++stats.fused;
+    } else {
+      ++stats.outliers;
+    }
   }
   return stats;
 }

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "backend/depth_propagation.h"
+#include "backend/edge_ba_line_depth.h"
 #include "backend/epipolar_stereo.h"
 #include "backend/line_regularizer.h"
 #include "backend/mapping_options.h"
@@ -41,6 +42,7 @@ namespace pldvo {
 struct FrameUpdateStats {
   int line_attempts = 0;      // edge pixels with a matched line
   int line_ok = 0;            // fused or created from the line-guided match
+  int line_refined = 0;       // of which: refined by the restricted SSD search
   int line_fallback = 0;      // near-parallel: fell back to the SSD search
   int line_rejected = 0;      // out of the prior interval or failed the SSD check
   int line_out_of_range = 0;  // of which: outside the prior interval idepth +- 2 sigma
@@ -54,6 +56,14 @@ struct FrameUpdateStats {
   int num_edge_pixels = 0;       // candidates on an edge that were processed
   double edge_stereo_ms = 0.0;   // wall time of the stereo on edge pixels
   double other_stereo_ms = 0.0;  // wall time of the stereo on all other pixels
+};
+
+// FuseLineDepths: what happened to the valid pixels on edges with a line.
+struct LineDepthFusionStats {
+  int pixels = 0;    // valid pixels whose edge has a line
+  int skipped = 0;   // ray near-parallel to the line, behind the camera or missing it
+  int fused = 0;     // EKF updates
+  int outliers = 0;  // rejected by the EKF gate
 };
 
 class DepthMapper {
@@ -74,6 +84,15 @@ class DepthMapper {
   // SSD search.
   FrameUpdateStats UpdateWithFrame(const cv::Mat& image, const SE3& cur_from_ref,
                                    const std::vector<MatchedLine>& lines_in_cur);
+
+  // Fuses the edge BA's optimised 3D lines (keyframe frame, with tangent covariances;
+  // edge_ba_line_depth.h): every valid pixel whose edge id has a line gets the inverse depth of
+  // the ray's closest approach to the line, with the variance J Sigma J^T, fused by
+  // SemiDenseDepthMap::Fuse (EKF with its outlier gate). A ray missing the line by more than
+  // kLineDepthMissPx pixels (as an angle, kLineDepthMissPx / max(fx, fy)) is skipped: traced
+  // pixels lie up to 1.5 px off their keyframe line.
+  static constexpr double kLineDepthMissPx = 2.0;
+  LineDepthFusionStats FuseLineDepths(const std::vector<KeyframeLine>& lines);
 
   // A copy of the filter state with inverse-variance smoothing (if smooth) and the 3D line
   // regularisation of the keyframe's edges (if line_regularize).

@@ -24,6 +24,12 @@ std::string EdgeBAOptions::Check() const {
   if (!(min_plane_angle_deg >= 0.0) || !(min_plane_angle_deg < 90.0)) {
     return "backend.edge_ba.min_plane_angle_deg must be in [0, 90)";
   }
+  if (!(motion_prior_translation_ratio > 0.0) || !std::isfinite(motion_prior_translation_ratio)) {
+    return "backend.edge_ba.motion_prior_translation_ratio must be positive and finite";
+  }
+  if (!(motion_prior_rotation_deg > 0.0) || !std::isfinite(motion_prior_rotation_deg)) {
+    return "backend.edge_ba.motion_prior_rotation_deg must be positive and finite";
+  }
   if (num_threads < 1) return "backend.edge_ba.num_threads must be >= 1";
   if (max_queue < 1) return "backend.edge_ba.max_queue must be >= 1";
   return "";

@@ -84,10 +84,22 @@ struct EdgeBAOptions {
   // ... and a largest angle between its back-projected planes of at least this many degrees
   // (planes that nearly coincide leave the line's depth in the plane unconstrained).
   double min_plane_angle_deg = 2.0;
+  // Motion prior (backend/edge_ba_motion_prior.h) between consecutive window keyframes that
+  // carry a tracked relative pose (EdgeBAKeyframe::has_motion_prior): translation sigma
+  // motion_prior_translation_ratio * |t| (scale-free), rotation sigma motion_prior_rotation_deg.
+  // Without it, the line-only problem of a short-baseline window moved well-tracked keyframes by
+  // centimetres (docs/edge_ba.md, "In the odometry").
+  bool motion_prior = true;
+  double motion_prior_translation_ratio = 0.01;
+  double motion_prior_rotation_deg = 0.1;
   EdgeBALinearSolver linear_solver = EdgeBALinearSolver::kSparseSchur;
   int num_threads = 1;
   // Snapshots waiting in EdgeBundleAdjuster's queue; a new one beyond this drops the oldest.
   int max_queue = 2;
+  // After a successful solve, the optimised lines' marginal covariances (ceres::Covariance,
+  // tangent space of LineManifold<3>) are computed on the solving thread, and the odometry fuses
+  // the lines the current keyframe observes into its depth map (docs/edge_ba.md).
+  bool line_depth_feedback = true;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
@@ -116,11 +128,20 @@ struct EdgeBAOptions {
             "Window keyframes that must observe a free line (>= 2).");
     v.Field("min_plane_angle_deg", &min_plane_angle_deg,
             "Smallest largest-angle between a free line's back-projected planes (degrees).");
+    v.Field("motion_prior", &motion_prior,
+            "Prior on consecutive keyframes' relative pose from tracking (default true).");
+    v.Field("motion_prior_translation_ratio", &motion_prior_translation_ratio,
+            "Translation sigma of the motion prior as a fraction of |t| (default 0.01).");
+    v.Field("motion_prior_rotation_deg", &motion_prior_rotation_deg,
+            "Rotation sigma of the motion prior, degrees (default 0.1).");
     v.Choice("linear_solver", &linear_solver, EdgeBALinearSolverNames(),
              "sparse_schur (SuiteSparse, lines eliminated first), dense_schur, "
              "sparse_normal_cholesky.");
     v.Field("num_threads", &num_threads, "Ceres threads per solve.");
     v.Field("max_queue", &max_queue, "Pending windows in the worker's queue (oldest dropped).");
+    v.Field("line_depth_feedback", &line_depth_feedback,
+            "Line covariances after each solve; optimised lines fused into the current "
+            "keyframe's depth map (default true).");
   }
   // "" when valid, otherwise what is wrong (names the key).
   std::string Check() const;

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "backend/edge_ba_line_triangulation.h"
+#include "backend/edge_ba_motion_prior.h"
 #include "residuals/baseline_prior_residual.h"
 #include "residuals/covariance_models.h"
 #include "residuals/line_observation_residual.h"
@@ -275,6 +276,22 @@ EdgeBAProblem EdgeBAProblemBuilder::Build(const EdgeBAWindow& window) const {
                                    loss, blocks);
         }
       }
+    }
+  }
+  if (options_.motion_prior) {
+    // Window keyframes are consecutive in `window.keyframes`, so w - 1 is the previous one.
+    const double sigma_r = options_.motion_prior_rotation_deg * M_PI / 180.0;
+    for (int w = 1; w < num_window; ++w) {
+      const EdgeBAKeyframe& keyframe = window.keyframes[out.keyframe_indices[w]];
+      if (!keyframe.has_motion_prior || (out.pose_fixed[w - 1] && out.pose_fixed[w])) continue;
+      // A floor for keyframes at (nearly) the same position: 1e-6 of the unit scale.
+      const double sigma_t = std::max(options_.motion_prior_translation_ratio *
+                                          keyframe.previous_from_this.translation().norm(),
+                                      1e-6);
+      problem.AddResidualBlock(std::unique_ptr<ceres::CostFunction>(EdgeBAMotionPrior::Create(
+                                   keyframe.previous_from_this, sigma_t, sigma_r)),
+                               nullptr, {out.poses[w - 1].data(), out.poses[w].data()});
+      ++out.num_motion_priors;
     }
   }
   if (out.baseline_keyframe_a >= 0) {

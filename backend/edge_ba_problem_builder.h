@@ -41,6 +41,7 @@ struct EdgeBAProblem {
   int baseline_keyframe_b = -1;
   double baseline = 0.0;
   int num_pixel_residuals = 0;
+  int num_motion_priors = 0;  // EdgeBAMotionPrior blocks
 
   // Blocks that the solver varies (lines first, for the Schur ordering).
   std::vector<double*> VariableLineBlocks();

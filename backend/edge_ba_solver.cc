@@ -1,5 +1,6 @@
 #include "backend/edge_ba_solver.h"
 
+#include <ceres/covariance.h>
 #include <ceres/ordered_groups.h>
 #include <ceres/problem.h>
 
@@ -15,6 +16,25 @@ namespace {
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The marginal tangent covariances of the variable line blocks of the solved problem, by block
+// address; false when ceres::Covariance fails (rank-deficient Jacobian).
+bool LineCovariances(const std::vector<double*>& lines, ceres::Problem* problem,
+                     std::map<const double*, Eigen::Matrix4d>* covariances) {
+  ceres::Covariance::Options options;
+  options.num_threads = 1;
+  ceres::Covariance covariance(options);
+  std::vector<std::pair<const double*, const double*>> blocks;
+  for (const double* line : lines) blocks.emplace_back(line, line);
+  if (!covariance.Compute(blocks, problem)) return false;
+  for (const double* line : lines) {
+    Eigen::Matrix<double, 4, 4, Eigen::RowMajor> block;
+    if (!covariance.GetCovarianceBlockInTangentSpace(line, line, block.data())) return false;
+    if (!block.allFinite()) return false;
+    (*covariances)[line] = block;
+  }
+  return true;
 }
 
 }  // namespace
@@ -61,6 +81,7 @@ EdgeBAResult SolveEdgeBA(const EdgeBAWindow& window, const EdgeBAOptions& option
   const auto build_start = std::chrono::steady_clock::now();
   EdgeBAProblem problem = EdgeBAProblemBuilder(options).Build(window);
   EdgeBAResult result;
+  std::map<const double*, Eigen::Matrix4d> line_covariances;
   result.build_seconds = SecondsSince(build_start);
   result.num_residuals = problem.num_pixel_residuals;
   for (EdgeBALineStatus status : problem.line_status) {
@@ -86,6 +107,12 @@ EdgeBAResult SolveEdgeBA(const EdgeBAWindow& window, const EdgeBAOptions& option
     if (!result.success) {
       // Keep the input estimates.
       problem = EdgeBAProblemBuilder(options).Build(window);
+    } else if (options.line_depth_feedback && !problem.VariableLineBlocks().empty()) {
+      const auto covariance_start = std::chrono::steady_clock::now();
+      result.covariance_ok =
+          LineCovariances(problem.VariableLineBlocks(), ceres_problem.get(), &line_covariances);
+      result.covariance_seconds = SecondsSince(covariance_start);
+      if (!result.covariance_ok) line_covariances.clear();
     }
   }
 
@@ -109,6 +136,11 @@ EdgeBAResult SolveEdgeBA(const EdgeBAWindow& window, const EdgeBAOptions& option
     line.line.point_in_world = Eigen::Vector3d(values[0], values[1], values[2]);
     line.line.direction_in_world = Eigen::Vector3d(values[3], values[4], values[5]).normalized();
     line.line.anchored = listed_it != listed.end() && listed_it->second->anchored;
+    const auto covariance_it = line_covariances.find(values);
+    if (line.status == EdgeBALineStatus::kOptimized && covariance_it != line_covariances.end()) {
+      line.has_covariance = true;
+      line.tangent_covariance = covariance_it->second;
+    }
     result.lines.push_back(line);
   }
   return result;

@@ -21,7 +21,10 @@ ceres::Solver::Options MakeEdgeBASolverOptions(const EdgeBAOptions& options,
                                                EdgeBAProblem* problem);
 
 // Builds and solves the window; never throws on a degenerate window (success = false and a
-// message), throws std::invalid_argument on invalid options or a malformed window.
+// message), throws std::invalid_argument on invalid options or a malformed window. With
+// options.line_depth_feedback, a successful solve also returns the optimised lines' marginal
+// tangent covariances (ceres::Covariance, EdgeBAResultLine::tangent_covariance; covariance_ok
+// false when that fails).
 EdgeBAResult SolveEdgeBA(const EdgeBAWindow& window, const EdgeBAOptions& options);
 
 }  // namespace pldvo

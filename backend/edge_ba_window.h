@@ -34,6 +34,10 @@ struct EdgeBAKeyframe {
   int id = -1;
   SE3 cam_from_world;
   std::vector<EdgeBAObservation> observations;
+  // Optional motion prior (EdgeBAOptions::motion_prior): the pose of this keyframe relative to
+  // the previous keyframe of the window as tracking measured it (previous_from_this).
+  bool has_motion_prior = false;
+  SE3 previous_from_this;
 };
 
 // A 3D line: any point on it and its direction (need not be unit), in the world.
@@ -69,6 +73,10 @@ enum class EdgeBALineStatus {
 struct EdgeBAResultLine {
   EdgeBALine line;  // refined (or unchanged when not kOptimized); direction unit
   EdgeBALineStatus status = EdgeBALineStatus::kDropped;
+  // kOptimized lines when EdgeBAResult::covariance_ok: the marginal covariance of the line's
+  // tangent perturbation (LineManifold<3>::Plus at [point, direction], world frame), 4x4.
+  bool has_covariance = false;
+  Eigen::Matrix4d tangent_covariance = Eigen::Matrix4d::Zero();
 };
 
 struct EdgeBAResultKeyframe {
@@ -95,6 +103,10 @@ struct EdgeBAResult {
   double final_cost = 0.0;
   double build_seconds = 0.0;
   double solve_seconds = 0.0;
+  // EdgeBAOptions::line_depth_feedback: the line covariances were computed (false when the
+  // option is off, the solve failed or ceres::Covariance failed, e.g. rank-deficient).
+  bool covariance_ok = false;
+  double covariance_seconds = 0.0;  // attempted computations only
 };
 
 }  // namespace pldvo

@@ -94,32 +94,42 @@ class NormalEquations {
       }
 
       // Tangent-space Jacobians: J_tangent = J_ambient * PlusJacobian.
+      int variable_blocks = 0;
+      int last_variable = -1;
       for (int k = 0; k < num_blocks; ++k) {
         const int index = block.parameter_block_indices[k];
         if (tangent_offset_[index] < 0) continue;
+        ++variable_blocks;
+        last_variable = index;
         const int ambient = problem_.parameter_blocks()[index].size;
         const int tangent = problem_.parameter_blocks()[index].TangentSize();
         Eigen::Map<const RowMajorMatrix> plus(plus_jacobian_[index].data(), ambient, tangent);
         Eigen::Map<const RowMajorMatrix> jac_ambient(ambient_jacobian_[index].data(), rows,
                                                      ambient);
         Eigen::Map<RowMajorMatrix> jac_tangent(tangent_jacobian_[index].data(), rows, tangent);
-        for (int r = 0; r < rows; ++r) {
-          for (int c = 0; c < tangent; ++c) {
-            double sum = 0.0;
-            for (int a = 0; a < ambient; ++a) sum += jac_ambient(r, a) * plus(a, c);
-            jac_tangent(r, c) = sum;
-          }
-        }
+        jac_tangent.noalias() = jac_ambient * plus;
         if (alpha_sq_norm != 0.0) {
-          // J <- J - alpha/s r (r^T J), column by column.
-          for (int c = 0; c < tangent; ++c) {
-            double r_dot_j = 0.0;
-            for (int r = 0; r < rows; ++r) r_dot_j += residuals_[r] * jac_tangent(r, c);
-            for (int r = 0; r < rows; ++r) {
-              jac_tangent(r, c) -= alpha_sq_norm * residuals_[r] * r_dot_j;
-            }
-          }
+          // J <- J - alpha/s r (r^T J).
+          Eigen::Map<const Eigen::VectorXd> r(residuals_.data(), rows);
+          const Eigen::RowVectorXd r_dot_j = r.transpose() * jac_tangent;
+          jac_tangent.noalias() -= (alpha_sq_norm * r) * r_dot_j;
         }
+      }
+
+      if (variable_blocks == 1) {
+        // One variable block (the tracking problems): H_bb += s^2 J^T J, g_b += s J^T (rs r) as
+        // block products.
+        const int offset = tangent_offset_[last_variable];
+        const int tangent = problem_.parameter_blocks()[last_variable].TangentSize();
+        Eigen::Map<const RowMajorMatrix> jac(tangent_jacobian_[last_variable].data(), rows,
+                                             tangent);
+        Eigen::Map<const Eigen::VectorXd> r(residuals_.data(), rows);
+        hessian_.block(offset, offset, tangent, tangent)
+            .selfadjointView<Eigen::Upper>()
+            .rankUpdate(jac.transpose(), jacobian_scaling * jacobian_scaling);
+        gradient_.segment(offset, tangent).noalias() +=
+            (jacobian_scaling * residual_scaling) * (jac.transpose() * r);
+        continue;
       }
 
       // Accumulate the upper triangle of H and g row by row through a dense tangent row.

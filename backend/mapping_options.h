@@ -65,6 +65,10 @@ struct MappingOptions {
   double min_line_epipolar_angle_deg = 10.0;
   // Check the line-guided match photometrically with one 5-sample SSD (max_ssd_rms).
   bool line_stereo_check_ssd = true;
+  // Refine a line-guided match by the 5-sample SSD search restricted to the line match's
+  // idepth +- search_sigmas sigma_lambda (the line disambiguates, the SSD localises); the SSD
+  // observation replaces the line one when the search succeeds.
+  bool line_stereo_refine_ssd = false;
 
   // ---- EKF fusion and outliers (Engel 2013 Sec. 2.3).
   // An observation further than gate sigmas from the prior (sqrt(V + V_obs)) is an outlier.
@@ -102,6 +106,10 @@ struct MappingOptions {
   // (occlusion or wrong depth).
   double max_propagation_intensity_diff = 25.0;
 
+  // ---- Tracking reference (reference_builder.h).
+  // At most this many points per pyramid level, evenly spaced in raster order (0 = all).
+  int max_reference_points = 4000;
+
   template <class Visitor>
   void VisitFields(Visitor& v) {
     v.Field("gradient_threshold", &gradient_threshold,
@@ -138,6 +146,8 @@ struct MappingOptions {
             "Below this epipolar/edge angle use the SSD search, degrees (default 10).");
     v.Field("line_stereo_check_ssd", &line_stereo_check_ssd,
             "Check line-guided matches with one 5-sample SSD (default true).");
+    v.Field("line_stereo_refine_ssd", &line_stereo_refine_ssd,
+            "Refine line-guided matches by an SSD search within +- search_sigmas of them.");
     v.Field("outlier_gate_sigmas", &outlier_gate_sigmas,
             "Observations further than this many sigmas are outliers (default 2).");
     v.Field("validity_initial", &validity_initial, "Validity counter of a new hypothesis (20).");
@@ -165,6 +175,8 @@ struct MappingOptions {
             "sigma_p^2 added when propagating to a new keyframe, (1/m)^2 (1e-4).");
     v.Field("max_propagation_intensity_diff", &max_propagation_intensity_diff,
             "Drop propagated hypotheses whose intensities differ more, gray levels (25).");
+    v.Field("max_reference_points", &max_reference_points,
+            "Tracking reference points per pyramid level, evenly spaced (0 = all; default 4000).");
   }
   // "" when valid, otherwise what is wrong (names the field).
   std::string Check() const;

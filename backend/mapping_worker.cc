@@ -11,11 +11,12 @@
 namespace pldvo {
 
 MappingWorker::MappingWorker(const PinholeCamera& camera, const MappingOptions& options,
-                             bool parallel, int max_pending_updates)
+                             bool parallel, int max_pending_updates, bool wait_when_behind)
     : camera_(camera),
       options_(options),
       parallel_(parallel),
       max_pending_updates_(std::max(1, max_pending_updates)),
+      wait_when_behind_(wait_when_behind),
       mapper_(camera, options) {
   if (parallel_) thread_ = std::thread(&MappingWorker::ThreadLoop, this);
 }
@@ -31,17 +32,27 @@ MappingWorker::~MappingWorker() {
   }
 }
 
-void MappingWorker::Submit(MappingJob job) {
+double MappingWorker::Submit(MappingJob job) {
   if (!parallel_) {
     Run(job);
-    return;
+    return 0.0;
   }
+  double wait_ms = 0.0;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (job.kind == MappingJob::Kind::kUpdate) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    auto pending_updates = [&] {
       int pending = 0;
       for (const MappingJob& queued : queue_) pending += queued.kind == MappingJob::Kind::kUpdate;
-      if (pending >= max_pending_updates_) {
+      return pending;
+    };
+    if (job.kind == MappingJob::Kind::kUpdate && pending_updates() >= max_pending_updates_) {
+      if (wait_when_behind_) {
+        const auto start = std::chrono::steady_clock::now();
+        job_done_.wait(lock, [&] { return pending_updates() < max_pending_updates_; });
+        wait_ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count();
+      } else {
         for (auto it = queue_.begin(); it != queue_.end(); ++it) {
           if (it->kind == MappingJob::Kind::kUpdate) {
             queue_.erase(it);
@@ -54,6 +65,7 @@ void MappingWorker::Submit(MappingJob job) {
     queue_.push_back(std::move(job));
   }
   job_ready_.notify_one();
+  return wait_ms;
 }
 
 std::shared_ptr<const KeyframeMap> MappingWorker::Latest() const {
@@ -98,6 +110,16 @@ int MappingWorker::failed_jobs() const {
   return failed_jobs_;
 }
 
+int MappingWorker::line_depths_fused() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return line_depths_fused_;
+}
+
+int MappingWorker::line_depth_outliers() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return line_depth_outliers_;
+}
+
 void MappingWorker::ThreadLoop() {
   while (true) {
     MappingJob job;
@@ -119,8 +141,8 @@ void MappingWorker::ThreadLoop() {
 }
 
 void MappingWorker::Publish(std::shared_ptr<KeyframeMap> keyframe_map) {
-  keyframe_map->reference = std::make_shared<const TrackingReference>(
-      BuildReferencePoints(*keyframe_map->map, keyframe_levels_, camera_));
+  keyframe_map->reference = std::make_shared<const TrackingReference>(BuildReferencePoints(
+      *keyframe_map->map, keyframe_levels_, camera_, options_.max_reference_points));
   keyframe_map->mean_idepth = MeanInverseDepth(*keyframe_map->map);
   keyframe_map->num_points =
       keyframe_map->reference->levels.empty()
@@ -152,6 +174,22 @@ void MappingWorker::Run(const MappingJob& job) {
         mapper_.UpdateWithFrame(job.image, job.cur_from_kf, job.lines_in_cur);
         ++num_updates_;
         break;
+      case MappingJob::Kind::kLineDepths: {
+        if (job.keyframe_id != keyframe_id_) return;  // for a keyframe no longer current
+        const LineDepthFusionStats stats = mapper_.FuseLineDepths(job.line_depths);
+        std::lock_guard<std::mutex> lock(mutex_);
+        line_depths_fused_ += stats.fused;
+        line_depth_outliers_ += stats.outliers;
+        // Often published right after the keyframe switch, before the odometry has read it: keep
+        // what the switch reported (retired map, propagation, random init).
+        if (latest_ != nullptr && latest_->keyframe_id == keyframe_id_) {
+          published->retired_map = latest_->retired_map;
+          published->retired_keyframe_id = latest_->retired_keyframe_id;
+          published->propagation = latest_->propagation;
+          published->random_init = latest_->random_init;
+        }
+        break;
+      }
       case MappingJob::Kind::kNewKeyframe: {
         if (job.keep_retired_map) {
           published->retired_map = std::make_shared<const SemiDenseDepthMap>(
@@ -179,7 +217,9 @@ void MappingWorker::Run(const MappingJob& job) {
     LOG(WARNING) << "mapping job for frame " << job.frame_index << " failed: " << e.what();
     std::lock_guard<std::mutex> lock(mutex_);
     ++failed_jobs_;
-    if (job.kind != MappingJob::Kind::kUpdate) failed_keyframe_id_ = job.keyframe_id;
+    if (job.kind == MappingJob::Kind::kInitialize || job.kind == MappingJob::Kind::kNewKeyframe) {
+      failed_keyframe_id_ = job.keyframe_id;
+    }
   }
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -1,13 +1,13 @@
 // The mapping side of the odometry: a DepthMapper (semi-dense keyframe depth filter) fed with
-// jobs (initialise a keyframe, fuse a tracked frame, switch to a new keyframe), run either in its
-// own thread (parallel) or inline on the caller's thread (deterministic). After every job the
-// worker publishes an immutable KeyframeMap: the regularised map and the tracking reference
-// points built from it (reference_builder.h), which the tracking thread picks up without copying
-// the filter state.
+// jobs (initialise a keyframe, fuse a tracked frame, switch to a new keyframe, fuse the edge BA's
+// optimised lines, DepthMapper::FuseLineDepths), run either in its own thread (parallel) or
+// inline on the caller's thread (deterministic). After every job the worker publishes an
+// immutable KeyframeMap: the regularised map and the tracking reference points built from it
+// (reference_builder.h), which the tracking thread picks up without copying the filter state.
 //
 // Ordering: jobs run in submission order. When more than `max_pending_updates` frame updates wait
 // in parallel mode, the oldest waiting update is dropped (counted in dropped_updates()); keyframe
-// jobs are never dropped.
+// and line-depth jobs are never dropped.
 #ifndef PLDVO_BACKEND_MAPPING_WORKER_H_
 #define PLDVO_BACKEND_MAPPING_WORKER_H_
 
@@ -46,7 +46,7 @@ struct KeyframeMap {
 };
 
 struct MappingJob {
-  enum class Kind { kInitialize, kUpdate, kNewKeyframe };
+  enum class Kind { kInitialize, kUpdate, kNewKeyframe, kLineDepths };
   Kind kind = Kind::kUpdate;
   int keyframe_id = -1;  // the keyframe the job concerns (the new one for kNewKeyframe)
   int frame_index = -1;
@@ -66,20 +66,26 @@ struct MappingJob {
   SE3 new_from_old;
   int min_propagated_points = 0;
   bool keep_retired_map = false;
+  // kLineDepths: the edge BA's optimised lines observed by keyframe_id, in its camera frame
+  // (DepthMapper::FuseLineDepths); ignored when keyframe_id is no longer current.
+  std::vector<KeyframeLine> line_depths;
 };
 
 class MappingWorker {
  public:
   // Throws std::invalid_argument on invalid camera or options.
+  // With wait_when_behind, Submit blocks while max_pending_updates frame updates are pending
+  // instead of dropping the oldest: the map then sees every frame whatever the machine's load.
   MappingWorker(const PinholeCamera& camera, const MappingOptions& options, bool parallel,
-                int max_pending_updates);
+                int max_pending_updates, bool wait_when_behind = false);
   ~MappingWorker();
   MappingWorker(const MappingWorker&) = delete;
   MappingWorker& operator=(const MappingWorker&) = delete;
 
   // Runs the job inline (not parallel) or queues it. A job that throws is counted in
-  // failed_jobs() and leaves the map as it was.
-  void Submit(MappingJob job);
+  // failed_jobs() and leaves the map as it was. Returns the ms spent waiting for the mapping
+  // thread to catch up (wait_when_behind), else 0.
+  double Submit(MappingJob job);
   // The latest published map (nullptr before the first keyframe).
   std::shared_ptr<const KeyframeMap> Latest() const;
   // Blocks until the published map belongs to keyframe_id (or the worker failed it); returns
@@ -93,6 +99,9 @@ class MappingWorker {
   double TakeRecentJobMs();
   int dropped_updates() const;
   int failed_jobs() const;
+  // Sum of LineDepthFusionStats::fused / ::outliers over every kLineDepths job.
+  int line_depths_fused() const;
+  int line_depth_outliers() const;
 
  private:
   void Run(const MappingJob& job);
@@ -103,6 +112,7 @@ class MappingWorker {
   MappingOptions options_;
   bool parallel_;
   int max_pending_updates_;
+  bool wait_when_behind_;
   DepthMapper mapper_;            // touched only by the job runner
   ImagePyramid keyframe_levels_;  // the keyframe's pyramid for the reference intensities
   int keyframe_id_ = -1;
@@ -119,6 +129,8 @@ class MappingWorker {
   double recent_job_ms_ = 0.0;
   int dropped_updates_ = 0;
   int failed_jobs_ = 0;
+  int line_depths_fused_ = 0;
+  int line_depth_outliers_ = 0;
   int failed_keyframe_id_ = -1;
   std::thread thread_;
 };

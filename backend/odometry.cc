@@ -4,10 +4,14 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <map>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
 
+#include "backend/edge_ba_line_depth.h"
+#include "backend/edge_ba_solver.h"
 #include "backend/keyframe_selector.h"
 #include "backend/reference_builder.h"
 
@@ -70,9 +74,17 @@ Odometry::Odometry(const PinholeCamera& camera, const OdometryConfig& config,
   const std::string error = config.Check();
   if (!error.empty()) throw std::invalid_argument("Odometry: config: " + error);
   if (config_.odometry.use_lines) frontend_ = std::make_unique<LineFrontend>(config_.lines);
-  mapper_ =
-      std::make_unique<MappingWorker>(camera_, config_.mapping, config_.odometry.parallel_mapping,
-                                      config_.odometry.mapping_queue_size);
+  mapper_ = std::make_unique<MappingWorker>(
+      camera_, config_.mapping, config_.odometry.parallel_mapping,
+      config_.odometry.mapping_queue_size, config_.odometry.wait_for_mapping);
+  const EdgeBAOptions& edge_ba = config_.backend.edge_ba;
+  if (edge_ba.enabled) {
+    edge_ba_window_ = std::make_unique<KeyframeWindow>(camera_, edge_ba.window,
+                                                       edge_ba.max_pixels_per_observation);
+    if (config_.odometry.parallel_mapping) {
+      edge_ba_adjuster_ = std::make_unique<EdgeBundleAdjuster>(edge_ba);
+    }
+  }
 }
 
 Odometry::~Odometry() = default;
@@ -81,6 +93,8 @@ OdometryStatistics Odometry::statistics() const {
   OdometryStatistics stats = stats_;
   stats.dropped_mapping_updates = mapper_->dropped_updates();
   stats.failed_mapping_jobs = mapper_->failed_jobs();
+  stats.edge_ba_line_depths_fused = mapper_->line_depths_fused();
+  stats.edge_ba_line_depth_outliers = mapper_->line_depth_outliers();
   return stats;
 }
 
@@ -144,7 +158,7 @@ OdometryFrameResult Odometry::Finalize(OdometryFrameResult result) {
 void Odometry::StartKeyframe(int index, double timestamp, const cv::Mat& image, LineFrame lines,
                              const SE3& world_from_cam, bool initialize, const SE3& new_from_old,
                              int min_propagated_points, OdometryTiming* timing,
-                             const cv::Mat& depth) {
+                             const std::vector<int>* previous_segment, const cv::Mat& depth) {
   MappingJob job;
   job.kind = initialize ? MappingJob::Kind::kInitialize : MappingJob::Kind::kNewKeyframe;
   job.keyframe_id = next_keyframe_id_++;
@@ -177,6 +191,86 @@ void Odometry::StartKeyframe(int index, double timestamp, const cv::Mat& image, 
   keyframe_.image = image;
   keyframe_.lines = std::move(lines);
   ++stats_.keyframes;
+  // The keyframe job goes first: a result applied in UpdateEdgeBA may send line depths for it.
+  const EdgeTrace edges = edge_ba_window_ != nullptr ? job.edges : EdgeTrace();
+  mapper_->Submit(std::move(job));
+  if (edge_ba_window_ != nullptr) UpdateEdgeBA(edges, previous_segment, new_from_old.Inverse());
+}
+
+void Odometry::UpdateEdgeBA(const EdgeTrace& edges, const std::vector<int>* previous_segment,
+                            const SE3& old_from_new) {
+  if (previous_segment == nullptr) {
+    edge_ba_window_->Clear();
+    edge_ba_window_->AddKeyframe(keyframe_.id, keyframe_.world_from_kf, edges, {}, nullptr);
+    return;
+  }
+  edge_ba_window_->AddKeyframe(keyframe_.id, keyframe_.world_from_kf, edges, *previous_segment,
+                               &old_from_new);
+  if (edge_ba_window_->size() < 2) return;
+  EdgeBAWindow window = edge_ba_window_->MakeWindow();
+  if (edge_ba_adjuster_ != nullptr) {
+    // The adjuster gets a copy; `window` keeps the submitted poses for the result.
+    edge_ba_window_->Remember(edge_ba_adjuster_->Submit(window), window);
+    return;
+  }
+  edge_ba_window_->Remember(-1, window);
+  ApplyEdgeBA(SolveEdgeBA(window, config_.backend.edge_ba));  // sequence -1
+}
+
+void Odometry::PollEdgeBA() {
+  if (edge_ba_adjuster_ == nullptr) return;
+  while (std::optional<EdgeBAResult> result = edge_ba_adjuster_->Poll()) ApplyEdgeBA(*result);
+}
+
+void Odometry::ApplyEdgeBA(const EdgeBAResult& result) {
+  ++stats_.edge_ba_windows;
+  edge_ba_times_ms_.push_back(1e3 * (result.build_seconds + result.solve_seconds));
+  if (result.covariance_seconds > 0.0) {
+    edge_ba_covariance_ms_.push_back(1e3 * result.covariance_seconds);
+  }
+  if (!edge_ba_window_->Apply(result)) return;
+  ++stats_.edge_ba_applied;
+  // The current keyframe's refined pose; the last good frame was tracked against it (or is it),
+  // so it moves rigidly with it and the motion model (a relative motion) stays valid.
+  SE3 world_from_kf;
+  if (edge_ba_window_->WorldFromKeyframe(keyframe_.id, &world_from_kf)) {
+    world_from_last_good_ =
+        world_from_kf * keyframe_.world_from_kf.Inverse() * world_from_last_good_;
+    keyframe_.world_from_kf = world_from_kf;
+  }
+  if (retiring_.id >= 0) edge_ba_window_->WorldFromKeyframe(retiring_.id, &retiring_.world_from_kf);
+  if (config_.backend.edge_ba.line_depth_feedback) SendLineDepths(result);
+}
+
+void Odometry::SendLineDepths(const EdgeBAResult& result) {
+  if (!result.covariance_ok) {
+    // Nothing to send without optimised lines; otherwise ceres::Covariance failed.
+    if (result.num_optimized_lines > 0) ++stats_.edge_ba_covariance_failures;
+    return;
+  }
+  // Only the current keyframe: the mapping thread holds no other map (older keyframes' maps are
+  // retired). Its segments associated with an optimised line, in its (refined) camera frame.
+  std::map<int, const EdgeBAResultLine*> optimized;
+  for (const EdgeBAResultLine& line : result.lines) {
+    if (line.status == EdgeBALineStatus::kOptimized && line.has_covariance) {
+      optimized[line.line.id] = &line;
+    }
+  }
+  const SE3 kf_from_world = keyframe_.world_from_kf.Inverse();
+  MappingJob job;
+  job.kind = MappingJob::Kind::kLineDepths;
+  job.keyframe_id = keyframe_.id;
+  job.frame_index = keyframe_.frame_index;
+  for (const auto& [segment, line_id] : edge_ba_window_->LinesOfKeyframe(keyframe_.id)) {
+    const auto it = optimized.find(line_id);
+    if (it == optimized.end()) continue;
+    const EdgeBALine& line = it->second->line;
+    job.line_depths.push_back(LineInCamera(kf_from_world, line.point_in_world,
+                                           line.direction_in_world, it->second->tangent_covariance,
+                                           segment));
+  }
+  if (job.line_depths.empty()) return;
+  ++stats_.edge_ba_line_depth_jobs;
   mapper_->Submit(std::move(job));
 }
 
@@ -260,7 +354,8 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, const cv::Mat
   }
 
   if (!initialized_) {
-    StartKeyframe(index, timestamp, image, std::move(lines), SE3(), true, SE3(), 0, &timing, depth);
+    StartKeyframe(index, timestamp, image, std::move(lines), SE3(), true, SE3(), 0, &timing,
+                  nullptr, depth);
     initialized_ = true;
     world_from_last_good_ = SE3();
     last_good_index_ = index;
@@ -270,6 +365,7 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, const cv::Mat
     return result;
   }
 
+  PollEdgeBA();
   RefreshMap(&timing);
   result.keyframe_id = keyframe_.id;
   const SE3 world_from_prior = PredictWorldFromCam(index);
@@ -283,14 +379,14 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, const cv::Mat
     result.num_reference_points = map_->num_points;
     result.mean_idepth = map_->mean_idepth;
     std::vector<MatchedLine> lines_in_cur;
+    std::vector<LineMatch> matches;
     if (frontend_ != nullptr && !keyframe_.lines.segments.empty() && !lines.segments.empty()) {
       const SegmentPredictor predictor =
           config_.odometry.predict_line_matches
               ? MakePredictor(camera_, prior_cur_from_kf, map_->mean_idepth)
               : SegmentPredictor();
       LineFrontendTiming match_timing;
-      const std::vector<LineMatch> matches =
-          frontend_->Match(keyframe_.lines, lines, predictor, &match_timing);
+      matches = frontend_->Match(keyframe_.lines, lines, predictor, &match_timing);
       timing.matching_ms = match_timing.matching_ms;
       result.num_matches = static_cast<int>(matches.size());
       lines_in_cur = MatchedLinesFromMatches(matches, lines.segments,
@@ -345,8 +441,17 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, const cv::Mat
       const KeyframeDecision decision = DecideKeyframe(
           config_.keyframes, cur_from_kf, map_->mean_idepth, overlap, keyframe_.frames_tracked);
       if (decision.new_keyframe) {
+        // The new keyframe's segments that the verified matches tie to the old keyframe's.
+        std::vector<int> previous_segment(lines.segments.size(), -1);
+        for (const LineMatch& match : matches) {
+          if (lines_in_cur[match.ref_index].matched) {
+            previous_segment[match.cur_index] = match.ref_index;
+          }
+        }
         StartKeyframe(index, timestamp, image, std::move(lines), world_from_cur, false, cur_from_kf,
-                      0, &timing);
+                      0, &timing, &previous_segment);
+        // Synchronous edge BA may have refined the new keyframe's pose.
+        result.world_from_cam = keyframe_.world_from_kf;
         result.status = FrameStatus::kKeyframe;
         result.keyframe_id = keyframe_.id;
         result.message = "new keyframe: " + decision.reason;
@@ -358,7 +463,7 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, const cv::Mat
         job.image = image;
         job.cur_from_kf = cur_from_kf;
         job.lines_in_cur = std::move(lines_in_cur);
-        mapper_->Submit(std::move(job));
+        timing.wait_ms += mapper_->Submit(std::move(job));
       }
       result.tracking = std::move(tracking);
       return result;
@@ -376,8 +481,9 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, const cv::Mat
   ++consecutive_lost_;
   recovering_ = true;
   if (consecutive_lost_ >= config_.odometry.reinit_after_lost) {
+    // Not associated with the old keyframe (an extrapolated pose): the edge BA window restarts.
     StartKeyframe(index, timestamp, image, std::move(lines), world_from_prior, false,
-                  prior_cur_from_kf, config_.odometry.reinit_min_points, &timing);
+                  prior_cur_from_kf, config_.odometry.reinit_min_points, &timing, nullptr);
     world_from_last_good_ = world_from_prior;
     last_good_index_ = index;
     consecutive_lost_ = 0;
@@ -390,6 +496,10 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, const cv::Mat
 
 void Odometry::Finish() {
   mapper_->Flush();
+  if (edge_ba_adjuster_ != nullptr) {
+    edge_ba_adjuster_->WaitIdle();
+    PollEdgeBA();
+  }
   if (observer_ == nullptr || !observer_->WantsKeyframeMaps() || keyframe_.id < 0) return;
   const std::shared_ptr<const KeyframeMap> map = mapper_->Latest();
   if (map == nullptr) return;

@@ -16,6 +16,13 @@
 // The first frame is a keyframe with a random inverse-depth map of large variance (monocular
 // initialisation; the scale is arbitrary). Mapping runs in its own thread unless
 // odometry.parallel_mapping is false (deterministic).
+// With backend.edge_ba.enabled, every new keyframe (after the first) submits the window of the
+// newest keyframes (KeyframeWindow) to windowed edge bundle adjustment: on EdgeBundleAdjuster's
+// worker thread, polled at the start of every frame, or synchronously at the keyframe when
+// odometry.parallel_mapping is false (deterministic). A result moves the window keyframes'
+// world_from_kf, and with it the current keyframe and the motion model; with
+// backend.edge_ba.line_depth_feedback, the optimised lines the current keyframe observes go to
+// the mapping thread and are fused into its depth map (docs/edge_ba.md).
 #ifndef PLDVO_BACKEND_ODOMETRY_H_
 #define PLDVO_BACKEND_ODOMETRY_H_
 
@@ -23,6 +30,8 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "backend/edge_ba_adjuster.h"
+#include "backend/keyframe_window.h"
 #include "backend/mapping_worker.h"
 #include "backend/odometry_config.h"
 #include "backend/odometry_observer.h"
@@ -43,6 +52,15 @@ struct OdometryStatistics {
   int reinitializations = 0;
   int dropped_mapping_updates = 0;
   int failed_mapping_jobs = 0;
+  int edge_ba_windows = 0;  // edge BA windows solved
+  int edge_ba_applied = 0;  // ... whose result moved the keyframe poses
+  // backend.edge_ba.line_depth_feedback: applied windows with optimised lines whose line
+  // covariances failed (no feedback), line-depth jobs sent to the mapping thread, and the pixels
+  // they fused / rejected.
+  int edge_ba_covariance_failures = 0;
+  int edge_ba_line_depth_jobs = 0;
+  int edge_ba_line_depths_fused = 0;
+  int edge_ba_line_depth_outliers = 0;
 };
 
 class Odometry {
@@ -68,6 +86,10 @@ class Odometry {
   OdometryStatistics statistics() const;
   // Wall time of every mapping job (ms), for the summary.
   std::vector<double> MappingJobTimesMs() const { return mapper_->JobTimesMs(); }
+  // Wall time of every solved edge BA window (problem build + solve on the solving thread, ms).
+  const std::vector<double>& EdgeBAWindowTimesMs() const { return edge_ba_times_ms_; }
+  // Wall time of the line covariances of every window that computed them (ms).
+  const std::vector<double>& EdgeBACovarianceTimesMs() const { return edge_ba_covariance_ms_; }
   const OdometryConfig& config() const { return config_; }
 
  private:
@@ -85,16 +107,30 @@ class Odometry {
                               const cv::Mat& depth);
   // Makes the frame the keyframe with id next_keyframe_id_: initial (random map) when
   // `initialize`, otherwise propagated from the current keyframe with new_from_old.
+  // previous_segment: per segment of `lines`, the current keyframe's segment it was matched to
+  // (or -1), for the edge BA's line association; null when not associated (window restarts).
   void StartKeyframe(int index, double timestamp, const cv::Mat& image, LineFrame lines,
                      const SE3& world_from_cam, bool initialize, const SE3& new_from_old,
                      int min_propagated_points, OdometryTiming* timing,
-                     const cv::Mat& depth = cv::Mat());
+                     const std::vector<int>* previous_segment, const cv::Mat& depth = cv::Mat());
   // The map of the current keyframe, waiting for it after a switch.
   void RefreshMap(OdometryTiming* timing);
   TrackingResult TrackWithAlternatives(const ImagePyramid& pyramid, const cv::Mat& image, int index,
                                        const SE3& prior_cur_from_kf,
                                        const SE3& last_good_cur_from_kf, int* tried);
   SE3 PredictWorldFromCam(int index) const;
+  // Edge BA: adds the new keyframe to the window (previous_segment: see
+  // KeyframeWindow::AddKeyframe; old_from_new: its tracked pose relative to the previous
+  // keyframe) and, when the window has two keyframes or more, solves it (synchronous) or submits
+  // it (parallel). A null previous_segment restarts the window with this keyframe.
+  void UpdateEdgeBA(const EdgeTrace& edges, const std::vector<int>* previous_segment,
+                    const SE3& old_from_new);
+  // Applies the results the worker has finished.
+  void PollEdgeBA();
+  void ApplyEdgeBA(const EdgeBAResult& result);
+  // backend.edge_ba.line_depth_feedback: a kLineDepths job with the result's optimised lines
+  // that the current keyframe observes (counts a failed covariance instead).
+  void SendLineDepths(const EdgeBAResult& result);
   void NotifyRetired(const KeyframeMap& map);
   OdometryFrameResult Finalize(OdometryFrameResult result);
 
@@ -104,6 +140,11 @@ class Odometry {
   std::unique_ptr<LineFrontend> frontend_;
   Tracker tracker_;
   std::unique_ptr<MappingWorker> mapper_;
+  // Edge BA (null when disabled); the adjuster only in parallel mode.
+  std::unique_ptr<KeyframeWindow> edge_ba_window_;
+  std::unique_ptr<EdgeBundleAdjuster> edge_ba_adjuster_;
+  std::vector<double> edge_ba_times_ms_;
+  std::vector<double> edge_ba_covariance_ms_;
 
   bool initialized_ = false;
   int next_keyframe_id_ = 0;

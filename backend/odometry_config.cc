@@ -35,7 +35,7 @@ std::string OdometryConfig::Check() const {
       {"dataset", dataset.Check()},     {"lines", lines.Check()},
       {"tracking", tracking.Check()},   {"mapping", mapping.Check()},
       {"keyframes", keyframes.Check()}, {"odometry", odometry.Check()},
-      {"output", output.Check()}};
+      {"output", output.Check()},       {"backend", backend.Check()}};
   for (const auto& [name, error] : sections) {
     if (!error.empty()) return std::string(name) + ": " + error;
   }

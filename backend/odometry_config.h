@@ -10,16 +10,15 @@
 //   odometry   OdometryOptions (pyramid, line frontend on/off, alternative initial guesses,
 //              lost-tracking recovery, threading)
 //   output     OutputOptions (iteration images, keyframe depth PNGs, PLY point clouds)
+//   backend    BackendOptions: edge_ba = EdgeBAOptions (windowed edge bundle adjustment)
 // Defaults are the paper's configuration (experiments/configs/points_lines.yaml is empty of
 // overrides on purpose); docs/configuration.md lists every key.
-//
-// Edge bundle adjustment (backend/edge_ba*.h, another helper's work) has no section yet: when
-// its options exist, add `EdgeBaOptions edge_ba;` with `v.Section("edge_ba", ...)` here.
 #ifndef PLDVO_BACKEND_ODOMETRY_CONFIG_H_
 #define PLDVO_BACKEND_ODOMETRY_CONFIG_H_
 
 #include <string>
 
+#include "backend/edge_ba_options.h"
 #include "backend/mapping_options.h"
 #include "backend/tracker.h"
 #include "core/dataset.h"
@@ -100,6 +99,10 @@ struct OdometryOptions {
   // Pending mapping updates kept when the mapping thread falls behind; older pending frames are
   // dropped (counted). Keyframe creations are never dropped.
   int mapping_queue_size = 2;
+  // When mapping_queue_size updates are pending, wait for the mapping thread instead of dropping
+  // the oldest: every tracked frame updates the map, so results do not depend on the machine's
+  // load (the wait is reported as `wait`). false: real-time behaviour, updates are dropped.
+  bool wait_for_mapping = true;
   // Evaluation aid, off by default (monocular): initialise the first keyframe's map from the
   // first frame's depth image (TUM layout: 16-bit PNG, metres x 5000) with this inverse-depth
   // variance, which fixes the scale and removes the monocular initialisation; 0 = off.
@@ -132,6 +135,8 @@ struct OdometryOptions {
             "Mapping in its own thread; false runs it inline (deterministic).");
     v.Field("mapping_queue_size", &mapping_queue_size,
             "Pending mapping updates kept when mapping falls behind (default 2).");
+    v.Field("wait_for_mapping", &wait_for_mapping,
+            "Wait for the mapping thread when the queue is full instead of dropping updates.");
     v.Field("init_depth_idepth_var", &init_depth_idepth_var,
             "Evaluation aid: > 0 initialises the first keyframe from the dataset's depth image "
             "with this inverse-depth variance, (1/m)^2; 0 = monocular random init (default).");
@@ -161,6 +166,17 @@ struct OutputOptions {
   std::string Check() const;
 };
 
+// Optimisation beside tracking (docs/edge_ba.md).
+struct BackendOptions {
+  EdgeBAOptions edge_ba;  // off by default
+
+  template <class Visitor>
+  void VisitFields(Visitor& v) {
+    v.Section("edge_ba", &edge_ba, "Windowed edge bundle adjustment over the newest keyframes.");
+  }
+  std::string Check() const { return edge_ba.Check(); }
+};
+
 struct OdometryConfig {
   // Defaults of the sub-structs, except the line detector: EDLines (at 640x480 about 4x faster
   // than LSD; measured in docs/odometry.md).
@@ -173,6 +189,7 @@ struct OdometryConfig {
   KeyframeOptions keyframes;
   OdometryOptions odometry;
   OutputOptions output;
+  BackendOptions backend;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
@@ -183,6 +200,7 @@ struct OdometryConfig {
     v.Section("keyframes", &keyframes, "Keyframe selection.");
     v.Section("odometry", &odometry, "Pipeline, lost-tracking recovery and threading.");
     v.Section("output", &output, "Optional outputs of `pldvo run`.");
+    v.Section("backend", &backend, "Optimisation beside tracking (edge bundle adjustment).");
   }
   // "" when valid, otherwise the first section and what is wrong there.
   std::string Check() const;

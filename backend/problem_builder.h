@@ -7,7 +7,8 @@
 // Registered builders (tracking_problem_builder.h):
 //   "tracking"             photometric (eq. 1) and point-to-line (eqs. 4-5) blocks as the
 //                          weighting policy says, `batch_size` pixels per residual block, robust
-//                          loss row-wise inside the cost functions.
+//                          loss row-wise inside the cost functions, the current image sampled
+//                          with `interpolation`.
 //   "tracking_ceres_loss"  the same residuals with one block per pixel and the robust loss given
 //                          to the problem as a ceres::LossFunction (the per-pixel layout of the
 //                          issue; the Gauss-Newton solver applies the Triggs correction).
@@ -23,6 +24,7 @@
 #include "backend/tracking_reference.h"
 #include "core/image_pyramid.h"
 #include "core/options.h"
+#include "residuals/photometric_residual.h"
 #include "residuals/weighting.h"
 
 namespace pldvo {
@@ -32,11 +34,18 @@ struct ProblemBuilderOptions {
   // row-wise inside the cost functions, so a batch keeps per-pixel robustness. 128 measured as
   // fast as larger batches (docs/tracking.md, "Timing").
   int batch_size = 128;
+  // Sampling of the current image in the photometric residual (residuals/photometric_residual.h):
+  // bilinear (C0 cost, interpolated central-difference gradient) or bicubic (Keys / Catmull-Rom,
+  // C1 cost, exact derivative as gradient). Measurements: docs/tracking.md.
+  ImageInterpolation interpolation = ImageInterpolation::kBilinear;
   WeightingOptions weighting;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
     v.Field("batch_size", &batch_size, "Pixels per residual block (1 = one block per pixel).");
+    v.Choice("interpolation", &interpolation, ImageInterpolationNames(),
+             "Photometric sampling of the current image: bilinear (C0 cost) or bicubic (C1 "
+             "cost, exact Jacobian).");
     v.Section("weighting", &weighting, "Weighting of the residual families and robust loss.");
   }
   std::string Check() const;

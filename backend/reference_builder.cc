@@ -32,6 +32,15 @@ struct LevelSums {
   }
 };
 
+// Keeps max_points evenly spaced entries of `points` (raster order), index floor(k n / max).
+void ThinEvenly(int max_points, std::vector<ReferencePoint>* points) {
+  const size_t n = points->size();
+  if (max_points <= 0 || n <= static_cast<size_t>(max_points)) return;
+  const size_t kept = static_cast<size_t>(max_points);
+  for (size_t k = 0; k < kept; ++k) (*points)[k] = (*points)[k * n / kept];
+  points->resize(kept);
+}
+
 void AddPoints(const LevelSums& sums, const ImagePyramid& keyframe, int level,
                TrackingReferenceLevel* out) {
   const cv::Mat& image = keyframe.level(level);
@@ -55,7 +64,7 @@ void AddPoints(const LevelSums& sums, const ImagePyramid& keyframe, int level,
 }  // namespace
 
 TrackingReference BuildReferencePoints(const SemiDenseDepthMap& map, const ImagePyramid& keyframe,
-                                       const PinholeCamera& camera) {
+                                       const PinholeCamera& camera, int max_points_per_level) {
   if (keyframe.num_levels() < 1 || map.width() != keyframe.width(0) ||
       map.height() != keyframe.height(0) || camera.width != map.width() ||
       camera.height != map.height()) {
@@ -109,6 +118,7 @@ TrackingReference BuildReferencePoints(const SemiDenseDepthMap& map, const Image
       sums = std::move(coarse);
     }
     AddPoints(sums, keyframe, level, &out);
+    ThinEvenly(max_points_per_level, &out.points);
   }
   return reference;
 }

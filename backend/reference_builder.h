@@ -13,6 +13,11 @@
 // level-l keyframe pyramid at the level pixel; the edge id is that of the block's edge pixel
 // with the largest 1 / V (none when the block has no edge pixel).
 //
+// Budget: with max_points_per_level > 0 a level with n > max points keeps the points of raster
+// index floor(k n / max), k = 0..max-1: evenly spaced, so the subset covers the image like the
+// full set (a stride of n / max). Tracking time is linear in the points; the semi-dense map
+// itself is not thinned.
+//
 // Lines: the current-frame segment matched to keyframe edge e (LineMatch, ref_index = e) gives
 // MatchedLine e at level 0 (the segment's l and Sigma_l); LineAtLevel moves it to each level.
 #ifndef PLDVO_BACKEND_REFERENCE_BUILDER_H_
@@ -29,11 +34,11 @@
 
 namespace pldvo {
 
-// The points of every level (levels = keyframe.num_levels()); lines_in_cur left empty.
-// `keyframe` is the keyframe's pyramid, `camera` its level-0 camera; throws
-// std::invalid_argument when the map, pyramid and camera sizes differ.
+// The points of every level (levels = keyframe.num_levels()), at most max_points_per_level each
+// (0 = all); lines_in_cur left empty. `keyframe` is the keyframe's pyramid, `camera` its level-0
+// camera; throws std::invalid_argument when the map, pyramid and camera sizes differ.
 TrackingReference BuildReferencePoints(const SemiDenseDepthMap& map, const ImagePyramid& keyframe,
-                                       const PinholeCamera& camera);
+                                       const PinholeCamera& camera, int max_points_per_level = 0);
 
 // Level-0 matched lines indexed by keyframe edge id (= keyframe segment index): entry
 // match.ref_index holds cur_segments[match.cur_index]; entries without a match are unmatched.

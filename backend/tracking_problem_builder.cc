@@ -87,7 +87,8 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
       stats.photometric_residuals += static_cast<int>(observations.size());
       ++stats.residual_blocks;
       problem->AddResidualBlock(std::unique_ptr<ceres::CostFunction>(PhotometricResidual::Create(
-                                    current, level, camera, std::move(observations), loss_inside)),
+                                    current, level, camera, std::move(observations), loss_inside,
+                                    options_.interpolation)),
                                 loss_outside, {cur_from_ref});
       observations.clear();
       observations.reserve(batch);

@@ -3,7 +3,8 @@
 //   E(xi) = sum_i rho((r_i / sigma_ri)^2) + sum_j rho((g_j / sigma_gj)^2)        (eqs. 1-7)
 //
 // with the photometric residuals r_i = I_ref(x_i) - I_cur(tau(x_i, d_i, xi)) of every reference
-// point (eq. 1, residuals/photometric_residual.h) and the point-to-line residuals
+// point (eq. 1, residuals/photometric_residual.h; I_cur sampled bilinearly or bicubically as
+// `interpolation` says) and the point-to-line residuals
 // g_j = l_j^T tau(x_j, d_j, xi) of every point on an edge with a matched current line
 // (eqs. 4-5, residuals/point_to_line_residual.h). The variances sigma^2 (eqs. 6-7) come from
 // residuals/weighting.h at the linearisation point (the pose held by the parameter block when

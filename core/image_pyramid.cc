@@ -33,9 +33,12 @@ ImagePyramid::ImagePyramid(const cv::Mat& image, int num_levels) {
   CHECK_GE(num_levels, 1);
   cv::Mat intensity;
   image.convertTo(intensity, CV_32F);
+  if (!intensity.isContinuous()) intensity = intensity.clone();
   levels_.reserve(num_levels);
+  intensity_levels_.reserve(num_levels);
   for (int level = 0; level < num_levels; ++level) {
     levels_.push_back(WithGradients(intensity));
+    intensity_levels_.push_back(intensity);
     if (level + 1 == num_levels || intensity.cols < 4 || intensity.rows < 4) break;
     cv::Mat half(intensity.rows / 2, intensity.cols / 2, CV_32F);
     for (int y = 0; y < half.rows; ++y) {
@@ -50,10 +53,6 @@ ImagePyramid::ImagePyramid(const cv::Mat& image, int num_levels) {
   }
 }
 
-cv::Mat ImagePyramid::Intensity(int level) const {
-  cv::Mat intensity;
-  cv::extractChannel(levels_[level], intensity, 0);
-  return intensity;
-}
+cv::Mat ImagePyramid::Intensity(int level) const { return intensity_levels_[level].clone(); }
 
 }  // namespace pldvo

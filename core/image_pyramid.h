@@ -1,7 +1,9 @@
 // Image pyramid of float intensities with precomputed gradients, stored per level as one
 // interleaved CV_32FC3 image [I, dI/dx, dI/dy] so that one bilinear lookup yields the
 // intensity and its gradient (as in DSO's dI arrays). Level l+1 is the 2x2 average of level l;
-// gradients are central differences (zero on the one-pixel border).
+// gradients are central differences (zero on the one-pixel border). The intensity of each level
+// is also kept as a contiguous single-channel CV_32F plane, the layout ceres::Grid2D<float>
+// needs for bicubic sampling (residuals/photometric_residual.h).
 #ifndef PLDVO_CORE_IMAGE_PYRAMID_H_
 #define PLDVO_CORE_IMAGE_PYRAMID_H_
 
@@ -24,6 +26,8 @@ class ImagePyramid {
   const cv::Mat& level(int level) const { return levels_[level]; }
   // Intensity alone as a CV_32F image (a copy).
   cv::Mat Intensity(int level) const;
+  // The stored intensity plane of a level: row-major, continuous, width(level) floats per row.
+  const float* IntensityData(int level) const { return intensity_levels_[level].ptr<float>(); }
 
   // True when bilinear sampling at (x, y) stays inside the image.
   bool CanSample(int level, double x, double y) const {
@@ -44,6 +48,7 @@ class ImagePyramid {
 
  private:
   std::vector<cv::Mat> levels_;
+  std::vector<cv::Mat> intensity_levels_;  // CV_32F, continuous
 };
 
 }  // namespace pldvo

@@ -51,6 +51,7 @@ MapEvalRun RunVariant(const MapEvalConfig& config, bool line_stereo, double line
     other_ms += stats.other_stereo_ms;
     edge_pixels += stats.num_edge_pixels;
     run.line_ok += stats.line_ok;
+    run.line_refined += stats.line_refined;
     run.line_fallback += stats.line_fallback;
     run.line_rejected += stats.line_rejected;
     run.line_out_of_range += stats.line_out_of_range;
@@ -221,13 +222,15 @@ std::string FormatMapEvalTable(const MapEvalResult& r) {
   for (int v = 0; v < 2; ++v) {
     const MapEvalRun& run = *runs[v];
     std::snprintf(line, sizeof(line),
-                  "%s: %d/%d candidates valid; line ok %d, fallback %d, rejected %d (%d out of "
+                  "%s: %d/%d candidates valid; line ok %d (SSD-refined %d), fallback %d, rejected "
+                  "%d (%d out of "
                   "range); ssd ok %d; EKF outliers %d; 3D line reg: %d edges fitted, %d rejected, "
                   "%d px updated, %d outlier px\n",
                   v == 0 ? "photometric" : "line-guided", run.valid, run.candidates, run.line_ok,
-                  run.line_fallback, run.line_rejected, run.line_out_of_range, run.ssd_ok,
-                  run.outliers, run.line_stats.edges_fitted, run.line_stats.edges_rejected,
-                  run.line_stats.pixels_updated, run.line_stats.pixels_rejected);
+                  run.line_refined, run.line_fallback, run.line_rejected, run.line_out_of_range,
+                  run.ssd_ok, run.outliers, run.line_stats.edges_fitted,
+                  run.line_stats.edges_rejected, run.line_stats.pixels_updated,
+                  run.line_stats.pixels_rejected);
     out << line;
   }
   std::snprintf(line, sizeof(line),

@@ -61,8 +61,8 @@ struct MapEvalRun {
   double edge_stereo_us_per_pixel = 0.0;       // stereo wall time per processed edge pixel
   double first_frame_edge_us_per_pixel = 0.0;  // the same in the first frame (wide priors)
   double other_stereo_us_per_pixel = 0.0;
-  int line_ok = 0, line_fallback = 0, line_rejected = 0, line_out_of_range = 0, ssd_ok = 0,
-      outliers = 0;
+  int line_ok = 0, line_refined = 0, line_fallback = 0, line_rejected = 0, line_out_of_range = 0,
+      ssd_ok = 0, outliers = 0;
   int candidates = 0, valid = 0;
 };
 

@@ -9,14 +9,18 @@
 //   OUT/timing.csv       one row per frame: status, counts and the time of every component;
 //   OUT/summary.json     at the end: counts, median / mean ms per component, and with ground
 //                        truth rpe_cm_s, rpe_deg_s, ate_m, coverage (Sim(3)-aligned).
-// A frame that fails to load is reported with its file, marked failed and skipped.
+// A frame that fails to load is reported with its file, marked failed and skipped. Exit codes
+// (docs/reliability.md): 0 done; 1 a fatal input or output fault (dataset files, camera, output
+// folder, a failed write, no frame tracked at all); 2 a usage or config error.
 #include <gflags/gflags.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -189,13 +193,20 @@ int RunOdometryCommand(const CommandContext& context) {
     std::cerr << "pldvo run: cannot write into " << out << "\n";
     return 1;
   }
+  // A failed write (disk full, folder removed) stops the run: its output could not be kept.
+  const auto written = [&out](std::ostream& file, const char* name) {
+    if (file.flush()) return true;
+    std::cerr << "\npldvo run: cannot write " << out << "/" << name << ": " << std::strerror(errno)
+              << "; stopping (lines written so far are kept)\n";
+    return false;
+  };
   trajectory_file << "# pldvo run: timestamp tx ty tz qx qy qz qw (world_from_cam), dataset "
                   << FLAGS_dataset << "\n";
   timing_file << "index,timestamp,status,keyframe_id,lines,matches,reference_points,"
                  "alternatives,iterations,final_rms,inlier_fraction";
   for (const char* key : kTimingKeys) timing_file << "," << key << "_ms";
   timing_file << "\n";
-  timing_file.flush();
+  if (!written(trajectory_file, "trajectory.txt") || !written(timing_file, "timing.csv")) return 1;
 
   const int num_frames =
       FLAGS_max_frames > 0 ? std::min(FLAGS_max_frames, dataset->size()) : dataset->size();
@@ -244,7 +255,7 @@ int RunOdometryCommand(const CommandContext& context) {
     if (IsTracked(result.status)) {
       const StampedPose pose{result.timestamp, result.world_from_cam};
       WriteTumLine(pose, trajectory_file);
-      trajectory_file.flush();
+      if (!written(trajectory_file, "trajectory.txt")) return 1;
       estimate.push_back(pose);
     }
     TimingRow row;
@@ -270,7 +281,7 @@ int RunOdometryCommand(const CommandContext& context) {
                 << result.tracking.final_rms << "," << result.tracking.inlier_fraction;
     for (double value : Values(row)) timing_file << "," << std::setprecision(4) << value;
     timing_file << "\n";
-    timing_file.flush();
+    if (!written(timing_file, "timing.csv")) return 1;
     progress.Update(i + 1, odometry->statistics().lost_frames);
   }
   odometry->Finish();
@@ -293,6 +304,16 @@ int RunOdometryCommand(const CommandContext& context) {
   summary["parallel_mapping"] = config.odometry.parallel_mapping;
   summary["seconds"] = run_seconds;
   summary["fps"] = run_seconds > 0.0 ? num_frames / run_seconds : 0.0;
+  // Edge bundle adjustment (backend.edge_ba): windows solved, applied, CPU ms per window.
+  summary["edge_ba_windows"] = stats.edge_ba_windows;
+  summary["edge_ba_applied"] = stats.edge_ba_applied;
+  summary["edge_ba_ms_median"] = Median(odometry->EdgeBAWindowTimesMs());
+  // Line-depth feedback (backend.edge_ba.line_depth_feedback, docs/edge_ba.md).
+  summary["edge_ba_covariance_ms_median"] = Median(odometry->EdgeBACovarianceTimesMs());
+  summary["edge_ba_covariance_failures"] = stats.edge_ba_covariance_failures;
+  summary["edge_ba_line_depth_jobs"] = stats.edge_ba_line_depth_jobs;
+  summary["edge_ba_line_depths_fused"] = stats.edge_ba_line_depths_fused;
+  summary["edge_ba_line_depth_outliers"] = stats.edge_ba_line_depth_outliers;
   nlohmann::json median = nlohmann::json::object(), mean = nlohmann::json::object();
   const std::vector<double> mapping_jobs = odometry->MappingJobTimesMs();
   for (size_t k = 0; k < std::size(kTimingKeys); ++k) {
@@ -351,6 +372,11 @@ int RunOdometryCommand(const CommandContext& context) {
   }
   if (!evaluation_line.empty()) std::cout << "  " << evaluation_line << "\n";
   std::cout << "  outputs in " << out << "\n";
+  if (num_frames > 0 && stats.tracked == 0) {
+    std::cerr << "pldvo run: no frame was tracked (" << failed
+              << " failed to load); check the camera and the messages above\n";
+    return 1;
+  }
   return 0;
 }
 

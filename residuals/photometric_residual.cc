@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -14,8 +15,31 @@ namespace pldvo {
 namespace {
 
 // Sampling area [1, w - 2) x [1, h - 2): bilinear lookups then touch only pixels whose
-// central-difference gradient is defined (ImagePyramid leaves the one-pixel border at 0).
+// central-difference gradient is defined (ImagePyramid leaves the one-pixel border at 0), and
+// the bicubic 4x4 neighbourhood (rows and columns floor - 1 .. floor + 2) stays in the image.
 constexpr double kSamplingBorder = 1.0;
+
+// I_cur and its gradient (x = column, y = row) at a sub-pixel position inside the sampling
+// area. With gradient == false, gx and gy may be left unset.
+struct BilinearSampler {
+  const ImagePyramid& pyramid;
+  int level;
+  void operator()(double x, double y, bool /*gradient*/, double* f, double* gx, double* gy) const {
+    const Eigen::Vector3f sample = pyramid.Sample(level, x, y);
+    *f = sample[0];
+    *gx = sample[1];
+    *gy = sample[2];
+  }
+};
+
+template <class Interpolator>
+struct BicubicSampler {
+  const Interpolator& interpolator;
+  void operator()(double x, double y, bool gradient, double* f, double* gx, double* gy) const {
+    // Ceres' grids are indexed (row, column) = (y, x).
+    interpolator.Evaluate(y, x, f, gradient ? gy : nullptr, gradient ? gx : nullptr);
+  }
+};
 
 [[noreturn]] void ThrowInvalid(int line, const std::string& what) {
   std::ostringstream message;
@@ -28,12 +52,14 @@ constexpr double kSamplingBorder = 1.0;
 PhotometricResidual::PhotometricResidual(const ImagePyramid& cur_pyramid, int level,
                                          const PinholeCamera& camera,
                                          std::vector<PhotometricObservation> observations,
-                                         const ceres::LossFunction* loss)
+                                         const ceres::LossFunction* loss,
+                                         ImageInterpolation interpolation)
     : cur_pyramid_(cur_pyramid),
       level_(level),
       camera_(camera),
       observations_(std::move(observations)),
-      loss_(loss) {
+      loss_(loss),
+      interpolation_(interpolation) {
   if (observations_.empty()) ThrowInvalid(__LINE__, "empty batch");
   if (level < 0 || level >= cur_pyramid.num_levels()) {
     ThrowInvalid(__LINE__, "level " + std::to_string(level) + " outside the pyramid's " +
@@ -58,6 +84,12 @@ PhotometricResidual::PhotometricResidual(const ImagePyramid& cur_pyramid, int le
     }
     rays_in_ref_.push_back(camera_.Unproject(o.pixel_in_ref));
   }
+  if (interpolation_ == ImageInterpolation::kBicubic) {
+    grid_ = std::make_unique<const IntensityGrid>(cur_pyramid.IntensityData(level), 0,
+                                                  cur_pyramid.height(level), 0,
+                                                  cur_pyramid.width(level));
+    bicubic_ = std::make_unique<const BicubicInterpolator>(*grid_);
+  }
   valid_.assign(observations_.size(), 0);
   set_num_residuals(static_cast<int>(observations_.size()));
   mutable_parameter_block_sizes()->push_back(kPoseAmbientSize);
@@ -65,8 +97,20 @@ PhotometricResidual::PhotometricResidual(const ImagePyramid& cur_pyramid, int le
 
 namespace {
 
+// Calls body(sampler) with the sampler of the interpolation.
+template <class Interpolator, class Body>
+void WithSampler(ImageInterpolation interpolation, const ImagePyramid& pyramid, int level,
+                 const Interpolator* bicubic, Body&& body) {
+  if (interpolation == ImageInterpolation::kBicubic) {
+    body(BicubicSampler<Interpolator>{*bicubic});
+  } else {
+    body(BilinearSampler{pyramid, level});
+  }
+}
+
 // One row: residual and (optionally) its tangent Jacobian. Returns validity.
-inline bool PhotometricRow(const ImagePyramid& pyramid, int level, const PinholeCamera& camera,
+template <class Sampler>
+inline bool PhotometricRow(const Sampler& sample, const PinholeCamera& camera,
                            const PhotometricObservation& o, const Eigen::Vector3d& ray_in_ref,
                            const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation,
                            const ceres::LossFunction* loss, double* residual,
@@ -84,14 +128,15 @@ inline bool PhotometricRow(const ImagePyramid& pyramid, int level, const Pinhole
     if (jacobian_tangent != nullptr) std::fill(jacobian_tangent, jacobian_tangent + 6, 0.0);
     return false;
   }
-  const Eigen::Vector3f sample = pyramid.Sample(level, u, v);
+  double intensity_cur, gx, gy;
+  sample(u, v, jacobian_tangent != nullptr, &intensity_cur, &gx, &gy);
   double scale;
-  *residual = RobustifyRow(loss, o.sqrt_info * (o.intensity_ref - sample[0]), &scale);
+  *residual = RobustifyRow(loss, o.sqrt_info * (o.intensity_ref - intensity_cur), &scale);
   if (jacobian_tangent != nullptr) {
     // c = g^T dpi/dq (1x3); dr/dxi = -w [d c, (q x c)^T] since c^T (-[q]x) = (q x c)^T.
     const double inv_z = 1.0 / q.z();
-    const double gfx = sample[1] * camera.fx * inv_z;
-    const double gfy = sample[2] * camera.fy * inv_z;
+    const double gfx = gx * camera.fx * inv_z;
+    const double gfy = gy * camera.fy * inv_z;
     const Eigen::Vector3d c(gfx, gfy, -(gfx * u_over + gfy * v_over));
     const double w = -o.sqrt_info * scale;
     Eigen::Map<Eigen::Matrix<double, 6, 1>> row(jacobian_tangent);
@@ -111,16 +156,18 @@ bool PhotometricResidual::Evaluate(double const* const* parameters, double* resi
   double* jacobian = (jacobians != nullptr) ? jacobians[0] : nullptr;
   const MinusJacobianMatrix minus_jacobian =
       jacobian != nullptr ? PoseMinusJacobian(parameters[0]) : MinusJacobianMatrix::Zero();
-  double row_tangent[kPoseTangentSize];
   const int n = num_observations();
-  for (int i = 0; i < n; ++i) {
-    valid_[i] = PhotometricRow(cur_pyramid_, level_, camera_, observations_[i], rays_in_ref_[i],
-                               rotation, translation, loss_, residuals + i,
-                               jacobian != nullptr ? row_tangent : nullptr);
-    if (jacobian != nullptr) {
-      LiftTangentJacobian(minus_jacobian, row_tangent, 1, jacobian + i * kPoseAmbientSize);
+  WithSampler(interpolation_, cur_pyramid_, level_, bicubic_.get(), [&](const auto& sample) {
+    double row_tangent[kPoseTangentSize];
+    for (int i = 0; i < n; ++i) {
+      valid_[i] =
+          PhotometricRow(sample, camera_, observations_[i], rays_in_ref_[i], rotation, translation,
+                         loss_, residuals + i, jacobian != nullptr ? row_tangent : nullptr);
+      if (jacobian != nullptr) {
+        LiftTangentJacobian(minus_jacobian, row_tangent, 1, jacobian + i * kPoseAmbientSize);
+      }
     }
-  }
+  });
   return true;
 }
 
@@ -129,13 +176,15 @@ void PhotometricResidual::EvaluateTangent(const SE3& cur_from_ref, double* resid
   const Eigen::Matrix3d rotation = cur_from_ref.rotation_matrix();
   const Eigen::Vector3d& translation = cur_from_ref.translation();
   const int n = num_observations();
-  for (int i = 0; i < n; ++i) {
-    const bool ok = PhotometricRow(
-        cur_pyramid_, level_, camera_, observations_[i], rays_in_ref_[i], rotation, translation,
-        loss_, residuals + i,
-        jacobian_tangent != nullptr ? jacobian_tangent + i * kPoseTangentSize : nullptr);
-    if (valid != nullptr) valid[i] = ok;
-  }
+  WithSampler(interpolation_, cur_pyramid_, level_, bicubic_.get(), [&](const auto& sample) {
+    for (int i = 0; i < n; ++i) {
+      const bool ok = PhotometricRow(
+          sample, camera_, observations_[i], rays_in_ref_[i], rotation, translation, loss_,
+          residuals + i,
+          jacobian_tangent != nullptr ? jacobian_tangent + i * kPoseTangentSize : nullptr);
+      if (valid != nullptr) valid[i] = ok;
+    }
+  });
 }
 
 std::vector<Eigen::Vector2d> PhotometricResidual::ReprojectedPixels(

@@ -1,5 +1,6 @@
 // Evaluate() of the batched residuals with Jacobians, for a batch of 10 000 pixels on a
-// 640x480 image: the per-pixel cost of the inner loop of tracking.
+// 640x480 image: the per-pixel cost of the inner loop of tracking. The photometric benchmarks
+// take the image interpolation as argument `bicubic` (0 = bilinear, 1 = bicubic).
 //   build/experiments/benchmarks/residual_benchmark
 // items_per_second counts pixels (rows), so 1 / items_per_second is the time per pixel.
 #include <benchmark/benchmark.h>
@@ -80,7 +81,7 @@ void RunEvaluate(benchmark::State& state, const Cost& cost) {
   const double* parameters[] = {pose};
   double* jacobians[] = {jacobian.data()};
   for (auto _ : state) {
-    cost.Evaluate(parameters, residuals.data(), state.range(0) ? jacobians : nullptr);
+    cost.Evaluate(parameters, residuals.data(), state.range(0) != 0 ? jacobians : nullptr);
     benchmark::DoNotOptimize(residuals.data());
     benchmark::DoNotOptimize(jacobian.data());
   }
@@ -88,24 +89,35 @@ void RunEvaluate(benchmark::State& state, const Cost& cost) {
   state.counters["valid"] = cost.num_valid();
 }
 
+ImageInterpolation InterpolationArg(const benchmark::State& state, int index) {
+  return state.range(index) != 0 ? ImageInterpolation::kBicubic : ImageInterpolation::kBilinear;
+}
+
 void BM_PhotometricEvaluate(benchmark::State& state) {
   const Scene& scene = GetScene();
-  const PhotometricResidual cost(scene.pyramid, 0, scene.camera, scene.photometric);
+  const PhotometricResidual cost(scene.pyramid, 0, scene.camera, scene.photometric, nullptr,
+                                 InterpolationArg(state, 1));
   RunEvaluate(state, cost);
 }
-BENCHMARK(BM_PhotometricEvaluate)->Arg(0)->Arg(1)->ArgName("jacobians");
+BENCHMARK(BM_PhotometricEvaluate)
+    ->ArgsProduct({{0, 1}, {0, 1}})
+    ->ArgNames({"jacobians", "bicubic"});
 
 void BM_PhotometricEvaluateHuber(benchmark::State& state) {
   const Scene& scene = GetScene();
   const ceres::HuberLoss huber(1.345);
-  const PhotometricResidual cost(scene.pyramid, 0, scene.camera, scene.photometric, &huber);
+  const PhotometricResidual cost(scene.pyramid, 0, scene.camera, scene.photometric, &huber,
+                                 InterpolationArg(state, 1));
   RunEvaluate(state, cost);
 }
-BENCHMARK(BM_PhotometricEvaluateHuber)->Arg(1)->ArgName("jacobians");
+BENCHMARK(BM_PhotometricEvaluateHuber)
+    ->ArgsProduct({{1}, {0, 1}})
+    ->ArgNames({"jacobians", "bicubic"});
 
 void BM_PhotometricEvaluateTangent(benchmark::State& state) {
   const Scene& scene = GetScene();
-  const PhotometricResidual cost(scene.pyramid, 0, scene.camera, scene.photometric);
+  const PhotometricResidual cost(scene.pyramid, 0, scene.camera, scene.photometric, nullptr,
+                                 InterpolationArg(state, 0));
   std::vector<double> residuals(kBatch), jacobian(kBatch * 6);
   std::vector<std::uint8_t> valid(kBatch);
   for (auto _ : state) {
@@ -114,7 +126,7 @@ void BM_PhotometricEvaluateTangent(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * kBatch);
 }
-BENCHMARK(BM_PhotometricEvaluateTangent);
+BENCHMARK(BM_PhotometricEvaluateTangent)->Arg(0)->Arg(1)->ArgName("bicubic");
 
 void BM_PointToLineEvaluate(benchmark::State& state) {
   const Scene& scene = GetScene();

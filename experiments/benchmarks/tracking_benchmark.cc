@@ -1,7 +1,8 @@
 // One full coarse-to-fine tracking solve (4 levels, points and lines, covariance weights) of a
 // synthetic `lowtex` 640x480 frame pair (frames 10 -> 14, GT depth reference with GT line
-// matches), from the identity pose, per solver and residual layout:
-//   Track/<solver>/<builder>/batch:<N>[/<ceres linear solver>/threads:<T>]
+// matches), from the identity pose, per solver, residual layout and photometric interpolation:
+//   Track/<solver>/<builder>/batch:<N>[/<ceres linear solver>/threads:<T>][/bicubic]
+// (no suffix: bilinear, the default).
 // The time includes building each level's problem (weights, cost functions) and solving it.
 // Run: build/experiments/benchmarks/tracking_benchmark [--benchmark_filter=...]
 #include <benchmark/benchmark.h>
@@ -58,6 +59,7 @@ void RegisterAll() {
     int batch;
     SolverOptions::CeresLinearSolver linear;
     int threads;
+    ImageInterpolation interpolation = ImageInterpolation::kBilinear;
   };
   using LS = SolverOptions::CeresLinearSolver;
   const Variant variants[] = {
@@ -74,6 +76,14 @@ void RegisterAll() {
       {SolverOptions::Type::kCeres, "tracking", 128, LS::kDenseQr, 1},
       {SolverOptions::Type::kCeres, "tracking", 128, LS::kDenseNormalCholesky, 2},
       {SolverOptions::Type::kCeres, "tracking", 128, LS::kDenseQr, 2},
+      {SolverOptions::Type::kGaussNewton, "tracking", 1, LS::kDenseNormalCholesky, 1,
+       ImageInterpolation::kBicubic},
+      {SolverOptions::Type::kGaussNewton, "tracking", 128, LS::kDenseNormalCholesky, 1,
+       ImageInterpolation::kBicubic},
+      {SolverOptions::Type::kCeres, "tracking", 1, LS::kDenseNormalCholesky, 1,
+       ImageInterpolation::kBicubic},
+      {SolverOptions::Type::kCeres, "tracking", 128, LS::kDenseNormalCholesky, 1,
+       ImageInterpolation::kBicubic},
   };
   for (const Variant& v : variants) {
     TrackingOptions options;
@@ -82,6 +92,7 @@ void RegisterAll() {
     options.solver.num_threads = v.threads;
     options.problem_builder = v.builder;
     options.problem.batch_size = v.batch;
+    options.problem.interpolation = v.interpolation;
     options.record_edge_pixels = false;
     std::string name = std::string("Track/") +
                        (v.solver == SolverOptions::Type::kCeres ? "ceres" : "gauss_newton") + "/" +
@@ -90,6 +101,7 @@ void RegisterAll() {
       name += std::string(v.linear == LS::kDenseQr ? "/dense_qr" : "/dense_normal_cholesky") +
               "/threads:" + std::to_string(v.threads);
     }
+    if (v.interpolation == ImageInterpolation::kBicubic) name += "/bicubic";
     benchmark::RegisterBenchmark(name.c_str(), BM_Track, options)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();

@@ -60,6 +60,25 @@ TEST(DepthMapperTest, LineRegularizationReducesEdgeError) {
   EXPECT_GT(r.photometric.line_stats.edges_fitted, 20);
 }
 
+TEST(DepthMapperTest, SsdRefinementRescuesLineGuidedStereoFromNoisyLines) {
+  // At 1 px endpoint noise the plain line-guided match is worse than the SSD search; refining it
+  // by the SSD search within +- 2 sigma_lambda (mapping.line_stereo_refine_ssd) keeps the line's
+  // disambiguation and the SSD's localisation. Measured (edge median relative error after the 3D
+  // line regularisation): plain 0.0385, refined 0.0123, photometric 0.0129.
+  MapEvalConfig config = SmallConfig();
+  config.line_sigma_px = 1.0;
+  config.line_sigma_sweep = {};
+  const MapEvalResult plain = RunMapEvaluation(config);
+  config.mapping.line_stereo_refine_ssd = true;
+  const MapEvalResult refined = RunMapEvaluation(config);
+  const double plain_error = plain.line_guided.edges_line_regularized.median_rel_error;
+  const double refined_error = refined.line_guided.edges_line_regularized.median_rel_error;
+  const double photometric_error = refined.photometric.edges_line_regularized.median_rel_error;
+  EXPECT_GT(refined.line_guided.line_refined, 1000);
+  EXPECT_LT(refined_error, 0.5 * plain_error);
+  EXPECT_LT(refined_error, 1.2 * photometric_error);
+}
+
 TEST(DepthMapperTest, NeesInSaneBand) {
   const MapEvalResult& r = Result();
   // The error distribution is heavy-tailed (depth discontinuities, wrong matches), so the mean

@@ -18,39 +18,17 @@
 #include "core/config_io.h"
 #include "core/evaluation.h"
 #include "core/synthetic/synthetic_sequence.h"
+#include "tests/backend/rendered_sequence.h"
 
 namespace pldvo {
 namespace {
 
 constexpr int kFrames = 36;
 
-struct RenderedSequence {
-  synthetic::SyntheticSequence sequence;
-  std::vector<cv::Mat> images;  // CV_32F
-  cv::Mat first_depth;          // CV_32F metres, frame 0
-};
+using test::RenderedSequence;
 
 const RenderedSequence& Sequence() {
-  static const RenderedSequence rendered = [] {
-    synthetic::SynthOptions options;
-    options.preset = "lowtex";
-    options.frames = kFrames;
-    options.seed = 1;
-    options.width = 320;
-    options.height = 240;
-    options.fx = options.fy = 262.5;
-    options.threads = 2;
-    RenderedSequence result;
-    result.sequence = synthetic::MakeSequence(options);
-    for (int i = 0; i < kFrames; ++i) {
-      cv::Mat image;
-      const synthetic::RenderedFrame frame = synthetic::RenderFrame(result.sequence, i);
-      frame.image.convertTo(image, CV_32F);
-      result.images.push_back(image);
-      if (i == 0) result.first_depth = frame.depth;
-    }
-    return result;
-  }();
+  static const RenderedSequence rendered = test::RenderLowtexSequence(kFrames);
   return rendered;
 }
 

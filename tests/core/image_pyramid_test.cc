@@ -36,6 +36,25 @@ TEST(ImagePyramid, BilinearSampleOfARampIsExact) {
   }
 }
 
+TEST(ImagePyramid, IntensityPlaneIsContiguousAndEqualsChannelZero) {
+  // A region of interest (not continuous in memory) as input: the planes must still be
+  // contiguous row-major, width floats per row, as ceres::Grid2D reads them.
+  const cv::Mat full = Ramp(80, 60, 0.7, 1.3, 5.0);
+  const ImagePyramid pyramid(full(cv::Rect(3, 2, 64, 48)), 3);
+  for (int level = 0; level < pyramid.num_levels(); ++level) {
+    const float* plane = pyramid.IntensityData(level);
+    const cv::Mat& interleaved = pyramid.level(level);
+    const cv::Mat copy = pyramid.Intensity(level);
+    for (int y = 0; y < pyramid.height(level); ++y) {
+      for (int x = 0; x < pyramid.width(level); ++x) {
+        const float value = plane[y * pyramid.width(level) + x];
+        EXPECT_EQ(value, interleaved.ptr<float>(y)[3 * x]) << level << " " << x << " " << y;
+        EXPECT_EQ(value, copy.at<float>(y, x));
+      }
+    }
+  }
+}
+
 TEST(ImagePyramid, CanSampleGuardsTheBorder) {
   const ImagePyramid pyramid(cv::Mat(10, 20, CV_8U, cv::Scalar(0)), 1);
   EXPECT_TRUE(pyramid.CanSample(0, 0.0, 0.0));

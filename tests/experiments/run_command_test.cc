@@ -17,6 +17,7 @@
 #include "core/config_io.h"
 #include "core/synthetic/synthetic_sequence.h"
 #include "core/trajectory_io.h"
+#include "tests/experiments/test_folder.h"
 
 namespace pldvo {
 namespace {
@@ -24,24 +25,8 @@ namespace {
 namespace fs = std::filesystem;
 constexpr int kFrames = 36;  // 1.2 s: RPE needs pairs 1 s apart
 
-fs::path TestRoot() {
-  static const fs::path root = [] {
-    const fs::path dir =
-        fs::temp_directory_path() / ("pldvo_run_command_test_" + std::to_string(::getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-  }();
-  return root;
-}
-
-// Removes the test's temporary folder when the test process ends.
-class RemoveTestRoot : public ::testing::Environment {
- public:
-  void TearDown() override { fs::remove_all(TestRoot()); }
-};
-[[maybe_unused]] ::testing::Environment* const kRemoveTestRoot =
-    ::testing::AddGlobalTestEnvironment(new RemoveTestRoot);
+using test::Slurp;
+using test::TestRoot;
 
 // The synthetic sequence (written once per test process).
 fs::path SequenceDir() {
@@ -54,18 +39,14 @@ fs::path SequenceDir() {
     options.height = 240;
     options.fx = options.fy = 262.5;
     options.threads = 2;
+#ifdef PLDVO_SANITIZE
+    options.supersampling = 1;  // rendering dominates these tests under the sanitizers
+#endif
     const fs::path path = TestRoot() / "lowtex";
     synthetic::WriteSequence(synthetic::MakeSequence(options), path.string());
     return path;
   }();
   return dir;
-}
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream file(path);
-  std::stringstream text;
-  text << file.rdbuf();
-  return text.str();
 }
 
 int CountLines(const fs::path& path, bool skip_comments) {
@@ -170,8 +151,9 @@ TEST(RunCommandTest, CorruptFrameIsSkippedAndTheTrajectorySurvives) {
 }
 
 TEST(RunCommandTest, UnknownConfigKeyIsAnError) {
+  // The config is checked before the dataset is opened: no dataset needed.
   const fs::path log = TestRoot() / "run_bad_key.log";
-  EXPECT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " +
+  EXPECT_EQ(Pldvo("run --dataset " + (TestRoot() / "no_such_dataset").string() + " --out " +
                       (TestRoot() / "run_bad_key").string() + " --set keyframes.min_overlapp=0.5",
                   log),
             2);

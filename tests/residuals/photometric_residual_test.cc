@@ -1,6 +1,7 @@
 #include "residuals/photometric_residual.h"
 
 #include <ceres/autodiff_cost_function.h>
+#include <ceres/cubic_interpolation.h>
 #include <ceres/gradient_checker.h>
 #include <ceres/loss_function.h>
 #include <gtest/gtest.h>
@@ -29,11 +30,31 @@ std::unique_ptr<ceres::LossFunction> MakeLoss(Loss loss) {
   return nullptr;
 }
 
-// The autodiff twin: same residual written with Jets and the Jet-aware sampler.
+// The autodiff twin: same residual written with Jets and a Jet-aware sampler: for bilinear the
+// test sampler with the analytic model's gradient, for bicubic ceres::BiCubicInterpolator's own
+// Jet overload (the chain rule through the interpolant done by Ceres, not by our code).
 struct PhotometricTwin {
+  using Grid = ceres::Grid2D<float, 1>;
   PhotometricTwin(const ImagePyramid& pyramid, const PinholeCamera& camera,
-                  const std::vector<PhotometricObservation>& observations, Loss loss)
-      : pyramid(pyramid), camera(camera), observations(observations), loss(loss) {}
+                  const std::vector<PhotometricObservation>& observations, Loss loss,
+                  ImageInterpolation interpolation)
+      : pyramid(pyramid),
+        camera(camera),
+        observations(observations),
+        loss(loss),
+        interpolation(interpolation),
+        grid(pyramid.IntensityData(0), 0, pyramid.height(0), 0, pyramid.width(0)),
+        bicubic(grid) {}
+
+  template <typename T>
+  T Sample(const T& u, const T& v) const {
+    if (interpolation == ImageInterpolation::kBilinear) {
+      return testing_utils::SampleIntensity(pyramid, 0, u, v);
+    }
+    T intensity;
+    bicubic.Evaluate(v, u, &intensity);
+    return intensity;
+  }
 
   template <typename T>
   bool operator()(const T* pose, T* residuals) const {
@@ -46,8 +67,7 @@ struct PhotometricTwin {
       const Eigen::Matrix<T, 3, 1> q = rotation * ray + T(o.idepth) * translation;
       const T u = T(camera.fx) * q.x() / q.z() + T(camera.cx);
       const T v = T(camera.fy) * q.y() / q.z() + T(camera.cy);
-      const T r =
-          T(o.sqrt_info) * (T(o.intensity_ref) - testing_utils::SampleIntensity(pyramid, 0, u, v));
+      const T r = T(o.sqrt_info) * (T(o.intensity_ref) - Sample(u, v));
       if (loss == Loss::kHuber) {
         residuals[i] = testing_utils::HuberSqrtForm(r, kLossScale);
       } else if (loss == Loss::kCauchy) {
@@ -63,7 +83,18 @@ struct PhotometricTwin {
   const PinholeCamera camera;
   const std::vector<PhotometricObservation> observations;
   const Loss loss;
+  const ImageInterpolation interpolation;
+  const Grid grid;
+  const ceres::BiCubicInterpolator<Grid> bicubic;
 };
+
+// Where the observations reproject in the current image: random sub-pixel positions, bilinear
+// cell centres (x + 0.5, y + 0.5), or cell corners (integer x and y: every finite difference
+// straddles a cell boundary in both directions).
+enum class Placement { kRandom, kCellCentres, kCellCorners };
+
+constexpr ImageInterpolation kInterpolations[] = {ImageInterpolation::kBilinear,
+                                                  ImageInterpolation::kBicubic};
 
 class PhotometricResidualTest : public ::testing::Test {
  protected:
@@ -75,12 +106,12 @@ class PhotometricResidualTest : public ::testing::Test {
     PoseToParameters(cur_from_ref_, pose_);
   }
 
-  // `count` reference pixels reprojecting into the interior of the current image at random
-  // sub-pixel positions, or exactly at bilinear cell centres (x + 0.5, y + 0.5). Reference
+  // `count` reference pixels reprojecting into the interior of the current image as `placement`
+  // says. Reference
   // intensities are offset from the current ones so that the whitened residuals span both
   // zones of the robust losses.
   std::vector<PhotometricObservation> MakeObservations(const ImagePyramid& pyramid, int count,
-                                                       bool cell_centres, unsigned seed) const {
+                                                       Placement placement, unsigned seed) const {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u_dist(10.0, camera_.width - 11.0);
     std::uniform_real_distribution<double> v_dist(10.0, camera_.height - 11.0);
@@ -91,7 +122,8 @@ class PhotometricResidualTest : public ::testing::Test {
     std::vector<PhotometricObservation> observations;
     for (int i = 0; i < count; ++i) {
       Eigen::Vector2d pixel_in_cur(u_dist(rng), v_dist(rng));
-      if (cell_centres) pixel_in_cur = pixel_in_cur.array().floor() + 0.5;
+      if (placement == Placement::kCellCentres) pixel_in_cur = pixel_in_cur.array().floor() + 0.5;
+      if (placement == Placement::kCellCorners) pixel_in_cur = pixel_in_cur.array().round();
       PhotometricObservation o;
       PlaceReferencePixel(camera_, cur_from_ref_, pixel_in_cur, depth_dist(rng), &o.pixel_in_ref,
                           &o.idepth);
@@ -144,35 +176,40 @@ class PhotometricResidualTest : public ::testing::Test {
 // Analytic == autodiff twin (same sampling model), compared in the tangent space where both
 // are defined uniquely. Agreement is to rounding: 1e-9 relative to the largest entry.
 TEST_F(PhotometricResidualTest, AnalyticMatchesAutoDiff) {
-  for (const Loss loss_kind : {Loss::kNone, Loss::kHuber, Loss::kCauchy}) {
-    const auto loss = MakeLoss(loss_kind);
-    const auto observations = MakeObservations(smooth_, 40, false, 1);
-    const PhotometricResidual analytic(smooth_, 0, camera_, observations, loss.get());
-    ceres::AutoDiffCostFunction<PhotometricTwin, ceres::DYNAMIC, 7> twin(
-        new PhotometricTwin(smooth_, camera_, observations, loss_kind),
-        static_cast<int>(observations.size()));
-    const int n = static_cast<int>(observations.size());
-    Eigen::VectorXd r_analytic(n), r_twin(n);
-    Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor> j_analytic(n, 7), j_twin(n, 7);
-    const double* parameters[] = {pose_};
-    double* j_analytic_ptr[] = {j_analytic.data()};
-    double* j_twin_ptr[] = {j_twin.data()};
-    ASSERT_TRUE(analytic.Evaluate(parameters, r_analytic.data(), j_analytic_ptr));
-    ASSERT_TRUE(twin.Evaluate(parameters, r_twin.data(), j_twin_ptr));
-    EXPECT_EQ(analytic.num_valid(), n);
-    EXPECT_LT((r_analytic - r_twin).cwiseAbs().maxCoeff(), 1e-9);
-    const PlusJacobianMatrix plus = PosePlusJacobian(pose_);
-    const Eigen::MatrixXd tangent_analytic = j_analytic * plus;
-    const Eigen::MatrixXd tangent_twin = j_twin * plus;
-    const double scale = tangent_twin.cwiseAbs().maxCoeff();
-    EXPECT_LT((tangent_analytic - tangent_twin).cwiseAbs().maxCoeff(), 1e-9 * scale)
-        << "loss " << static_cast<int>(loss_kind);
-    // EvaluateTangent gives the same rows directly.
-    Eigen::VectorXd r_tangent(n);
-    Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> j_tangent(n, 6);
-    analytic.EvaluateTangent(cur_from_ref_, r_tangent.data(), j_tangent.data(), nullptr);
-    EXPECT_LT((r_tangent - r_analytic).cwiseAbs().maxCoeff(), 1e-12);
-    EXPECT_LT((Eigen::MatrixXd(j_tangent) - tangent_analytic).cwiseAbs().maxCoeff(), 1e-9 * scale);
+  for (const ImageInterpolation interpolation : kInterpolations) {
+    for (const Loss loss_kind : {Loss::kNone, Loss::kHuber, Loss::kCauchy}) {
+      const auto loss = MakeLoss(loss_kind);
+      const auto observations = MakeObservations(smooth_, 40, Placement::kRandom, 1);
+      const PhotometricResidual analytic(smooth_, 0, camera_, observations, loss.get(),
+                                         interpolation);
+      ceres::AutoDiffCostFunction<PhotometricTwin, ceres::DYNAMIC, 7> twin(
+          new PhotometricTwin(smooth_, camera_, observations, loss_kind, interpolation),
+          static_cast<int>(observations.size()));
+      const int n = static_cast<int>(observations.size());
+      Eigen::VectorXd r_analytic(n), r_twin(n);
+      Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor> j_analytic(n, 7), j_twin(n, 7);
+      const double* parameters[] = {pose_};
+      double* j_analytic_ptr[] = {j_analytic.data()};
+      double* j_twin_ptr[] = {j_twin.data()};
+      ASSERT_TRUE(analytic.Evaluate(parameters, r_analytic.data(), j_analytic_ptr));
+      ASSERT_TRUE(twin.Evaluate(parameters, r_twin.data(), j_twin_ptr));
+      EXPECT_EQ(analytic.num_valid(), n);
+      EXPECT_LT((r_analytic - r_twin).cwiseAbs().maxCoeff(), 1e-9);
+      const PlusJacobianMatrix plus = PosePlusJacobian(pose_);
+      const Eigen::MatrixXd tangent_analytic = j_analytic * plus;
+      const Eigen::MatrixXd tangent_twin = j_twin * plus;
+      const double scale = tangent_twin.cwiseAbs().maxCoeff();
+      EXPECT_LT((tangent_analytic - tangent_twin).cwiseAbs().maxCoeff(), 1e-9 * scale)
+          << "loss " << static_cast<int>(loss_kind) << " interpolation "
+          << static_cast<int>(interpolation);
+      // EvaluateTangent gives the same rows directly.
+      Eigen::VectorXd r_tangent(n);
+      Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> j_tangent(n, 6);
+      analytic.EvaluateTangent(cur_from_ref_, r_tangent.data(), j_tangent.data(), nullptr);
+      EXPECT_LT((r_tangent - r_analytic).cwiseAbs().maxCoeff(), 1e-12);
+      EXPECT_LT((Eigen::MatrixXd(j_tangent) - tangent_analytic).cwiseAbs().maxCoeff(),
+                1e-9 * scale);
+    }
   }
 }
 
@@ -193,8 +230,8 @@ constexpr double kEntryTolerance = 0.5;
 TEST_F(PhotometricResidualTest, GradientCheckerOnRampImageIsTight) {
   for (const Loss loss_kind : {Loss::kNone, Loss::kHuber, Loss::kCauchy}) {
     const auto loss = MakeLoss(loss_kind);
-    const PhotometricResidual cost(ramp_, 0, camera_, MakeObservations(ramp_, 30, false, 2),
-                                   loss.get());
+    const PhotometricResidual cost(ramp_, 0, camera_,
+                                   MakeObservations(ramp_, 30, Placement::kRandom, 2), loss.get());
     GradientCheck(cost, 1e-3, kEntryTolerance, 5e-4);
   }
 }
@@ -205,12 +242,12 @@ TEST_F(PhotometricResidualTest, GradientCheckerOnRampImageIsTight) {
 // constants (central difference h^2 f'''/6 plus interpolation h^2 f'''/8, against the forward
 // difference's h^2 f'''/24 and the cross-row average's h^2 f_xyy/8): about k^2 / 4 = 1.2 .. 1.5%
 // for the texture's wavenumbers k = 0.22 .. 0.24 /px, per gradient component. Measured
-// row-relative error 2.9%; bound 5%.
+// row-relative error 2.9%; bound 5%. (Bicubic sampling has no such model error, see below.)
 TEST_F(PhotometricResidualTest, GradientCheckerOnSmoothImageAtCellCentres) {
   for (const Loss loss_kind : {Loss::kNone, Loss::kHuber, Loss::kCauchy}) {
     const auto loss = MakeLoss(loss_kind);
-    const PhotometricResidual cost(smooth_, 0, camera_, MakeObservations(smooth_, 30, true, 3),
-                                   loss.get());
+    const PhotometricResidual cost(
+        smooth_, 0, camera_, MakeObservations(smooth_, 30, Placement::kCellCentres, 3), loss.get());
     GradientCheck(cost, 1e-3, kEntryTolerance, 5e-2);
   }
 }
@@ -220,15 +257,48 @@ TEST_F(PhotometricResidualTest, GradientCheckerOnSmoothImageAtCellCentres) {
 // difference, on top of the 3% model difference above (measured: per entry <= 2.0%, per row
 // <= 1.3%). Bound 5% for both.
 TEST_F(PhotometricResidualTest, GradientCheckerPerPixelSmallStep) {
-  const auto observations = MakeObservations(smooth_, 5, true, 4);
+  const auto observations = MakeObservations(smooth_, 5, Placement::kCellCentres, 4);
   for (const auto& observation : observations) {
     const PhotometricResidual cost(smooth_, 0, camera_, {observation});
     GradientCheck(cost, 1e-5, 5e-2, 5e-2);
   }
 }
 
+// Bicubic: the residual is a C1 function of the pose whose Jacobian is its exact derivative,
+// and the interpolant is evaluated in double from the float32 samples (constants), so numeric
+// differentiation sees no float32 rounding: with the style's relative step 1e-5 (the
+// reprojection moves ~1e-4 px) the check is tight at any sub-pixel position. What remains is
+// the O(h) error of a difference that straddles a cell boundary, where the interpolant's second
+// derivative jumps (at cell corners every difference does). Measured worst row-relative error
+// over 100 rows: 3.6e-5 at random positions, 9.9e-6 at cell corners (bilinear: 1.3 .. 2.9%,
+// tests above); bound 1e-4, and 1e-3 per entry (GradientChecker's own criterion; measured
+// 2.3e-4 for entries that nearly cancel).
+TEST_F(PhotometricResidualTest, GradientCheckerBicubicIsExactOnSmoothImage) {
+  for (const Placement placement : {Placement::kRandom, Placement::kCellCorners}) {
+    for (const Loss loss_kind : {Loss::kNone, Loss::kHuber, Loss::kCauchy}) {
+      const auto loss = MakeLoss(loss_kind);
+      const PhotometricResidual cost(smooth_, 0, camera_,
+                                     MakeObservations(smooth_, 100, placement, 7), loss.get(),
+                                     ImageInterpolation::kBicubic);
+      GradientCheck(cost, 1e-5, 1e-3, 1e-4);
+    }
+  }
+}
+
+// N = 1 (the per-pixel form) with bicubic sampling and the same step: measured per entry
+// <= 5.2e-6 (the worst where a difference straddles a cell boundary, 1e-11 elsewhere); bound
+// 1e-4 for entries and rows (bilinear needs 5%, GradientCheckerPerPixelSmallStep).
+TEST_F(PhotometricResidualTest, GradientCheckerBicubicPerPixelSmallStep) {
+  const auto observations = MakeObservations(smooth_, 5, Placement::kRandom, 8);
+  for (const auto& observation : observations) {
+    const PhotometricResidual cost(smooth_, 0, camera_, {observation}, nullptr,
+                                   ImageInterpolation::kBicubic);
+    GradientCheck(cost, 1e-5, 1e-4, 1e-4);
+  }
+}
+
 TEST_F(PhotometricResidualTest, RobustRowsSumToRobustCost) {
-  const auto observations = MakeObservations(smooth_, 50, false, 5);
+  const auto observations = MakeObservations(smooth_, 50, Placement::kRandom, 5);
   const int n = static_cast<int>(observations.size());
   for (const Loss loss_kind : {Loss::kHuber, Loss::kCauchy}) {
     const auto loss = MakeLoss(loss_kind);
@@ -264,21 +334,24 @@ TEST_F(PhotometricResidualTest, RobustRowsSumToRobustCost) {
 }
 
 TEST_F(PhotometricResidualTest, BatchRowsEqualPerPixelForm) {
-  const auto observations = MakeObservations(smooth_, 10, false, 6);
-  const PhotometricResidual batch(smooth_, 0, camera_, observations);
-  Eigen::VectorXd r_batch(10);
-  Eigen::Matrix<double, 10, 7, Eigen::RowMajor> j_batch;
-  const double* parameters[] = {pose_};
-  double* j_batch_ptr[] = {j_batch.data()};
-  batch.Evaluate(parameters, r_batch.data(), j_batch_ptr);
-  for (int i = 0; i < 10; ++i) {
-    const PhotometricResidual single(smooth_, 0, camera_, {observations[i]});
-    double r;
-    Eigen::Matrix<double, 1, 7> j;
-    double* j_ptr[] = {j.data()};
-    single.Evaluate(parameters, &r, j_ptr);
-    EXPECT_EQ(r, r_batch[i]);
-    EXPECT_EQ((j - j_batch.row(i)).cwiseAbs().maxCoeff(), 0.0);
+  for (const ImageInterpolation interpolation : kInterpolations) {
+    const auto observations = MakeObservations(smooth_, 10, Placement::kRandom, 6);
+    const PhotometricResidual batch(smooth_, 0, camera_, observations, nullptr, interpolation);
+    Eigen::VectorXd r_batch(10);
+    Eigen::Matrix<double, 10, 7, Eigen::RowMajor> j_batch;
+    const double* parameters[] = {pose_};
+    double* j_batch_ptr[] = {j_batch.data()};
+    batch.Evaluate(parameters, r_batch.data(), j_batch_ptr);
+    for (int i = 0; i < 10; ++i) {
+      const PhotometricResidual single(smooth_, 0, camera_, {observations[i]}, nullptr,
+                                       interpolation);
+      double r;
+      Eigen::Matrix<double, 1, 7> j;
+      double* j_ptr[] = {j.data()};
+      single.Evaluate(parameters, &r, j_ptr);
+      EXPECT_EQ(r, r_batch[i]);
+      EXPECT_EQ((j - j_batch.row(i)).cwiseAbs().maxCoeff(), 0.0);
+    }
   }
 }
 
@@ -299,32 +372,35 @@ TEST_F(PhotometricResidualTest, InvalidRowsAreZeroAndFlagged) {
   PlaceReferencePixel(camera_, cur_from_ref, Eigen::Vector2d(0.5, 50.0), 3.0,
                       &observations[3].pixel_in_ref, &observations[3].idepth);
   for (auto& o : observations) o.intensity_ref = 300.0;  // nonzero residual when valid
-  const PhotometricResidual cost(smooth_, 0, camera_, observations);
-  Eigen::Vector4d residuals;
-  Eigen::Matrix<double, 4, 7, Eigen::RowMajor> jacobian;
-  jacobian.setConstant(7.0);
-  const double* parameters[] = {pose};
-  double* jacobian_ptr[] = {jacobian.data()};
-  ASSERT_TRUE(cost.Evaluate(parameters, residuals.data(), jacobian_ptr));
-  EXPECT_TRUE(cost.valid(0));
-  EXPECT_NE(residuals[0], 0.0);
-  for (int i = 1; i < 4; ++i) {
-    EXPECT_FALSE(cost.valid(i)) << i;
-    EXPECT_EQ(residuals[i], 0.0) << i;
-    EXPECT_EQ(jacobian.row(i).cwiseAbs().maxCoeff(), 0.0) << i;
-  }
-  EXPECT_EQ(cost.num_valid(), 1);
+  // The same rule for both interpolations.
+  for (const ImageInterpolation interpolation : kInterpolations) {
+    const PhotometricResidual cost(smooth_, 0, camera_, observations, nullptr, interpolation);
+    Eigen::Vector4d residuals;
+    Eigen::Matrix<double, 4, 7, Eigen::RowMajor> jacobian;
+    jacobian.setConstant(7.0);
+    const double* parameters[] = {pose};
+    double* jacobian_ptr[] = {jacobian.data()};
+    ASSERT_TRUE(cost.Evaluate(parameters, residuals.data(), jacobian_ptr));
+    EXPECT_TRUE(cost.valid(0));
+    EXPECT_NE(residuals[0], 0.0);
+    for (int i = 1; i < 4; ++i) {
+      EXPECT_FALSE(cost.valid(i)) << i;
+      EXPECT_EQ(residuals[i], 0.0) << i;
+      EXPECT_EQ(jacobian.row(i).cwiseAbs().maxCoeff(), 0.0) << i;
+    }
+    EXPECT_EQ(cost.num_valid(), 1);
 
-  std::vector<std::uint8_t> valid;
-  const std::vector<Eigen::Vector2d> pixels = cost.ReprojectedPixels(cur_from_ref, &valid);
-  EXPECT_EQ(valid, (std::vector<std::uint8_t>{1, 0, 0, 0}));
-  EXPECT_NEAR(pixels[1].x(), -30.0, 1e-9);
-  EXPECT_TRUE(std::isnan(pixels[2].x()));
-  std::uint8_t tangent_valid[4];
-  double tangent_residuals[4];
-  cost.EvaluateTangent(cur_from_ref, tangent_residuals, nullptr, tangent_valid);
-  EXPECT_EQ(tangent_valid[0], 1);
-  EXPECT_EQ(tangent_valid[2], 0);
+    std::vector<std::uint8_t> valid;
+    const std::vector<Eigen::Vector2d> pixels = cost.ReprojectedPixels(cur_from_ref, &valid);
+    EXPECT_EQ(valid, (std::vector<std::uint8_t>{1, 0, 0, 0}));
+    EXPECT_NEAR(pixels[1].x(), -30.0, 1e-9);
+    EXPECT_TRUE(std::isnan(pixels[2].x()));
+    std::uint8_t tangent_valid[4];
+    double tangent_residuals[4];
+    cost.EvaluateTangent(cur_from_ref, tangent_residuals, nullptr, tangent_valid);
+    EXPECT_EQ(tangent_valid[0], 1);
+    EXPECT_EQ(tangent_valid[2], 0);
+  }
 }
 
 TEST_F(PhotometricResidualTest, ReprojectedPixelsHitTheirTargets) {

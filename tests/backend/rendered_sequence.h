@@ -1,0 +1,42 @@
+// Test helper: a short synthetic sequence (lowtex preset, seed 1, 320x240, f = 262.5, 30 fps)
+// rendered once per test process, with every frame as CV_32F and frame 0's depth.
+#ifndef PLDVO_TESTS_BACKEND_RENDERED_SEQUENCE_H_
+#define PLDVO_TESTS_BACKEND_RENDERED_SEQUENCE_H_
+
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "core/synthetic/synthetic_sequence.h"
+
+namespace pldvo::test {
+
+struct RenderedSequence {
+  synthetic::SyntheticSequence sequence;
+  std::vector<cv::Mat> images;  // CV_32F
+  cv::Mat first_depth;          // CV_32F metres, frame 0
+};
+
+inline RenderedSequence RenderLowtexSequence(int frames) {
+  synthetic::SynthOptions options;
+  options.preset = "lowtex";
+  options.frames = frames;
+  options.seed = 1;
+  options.width = 320;
+  options.height = 240;
+  options.fx = options.fy = 262.5;
+  options.threads = 2;
+  RenderedSequence result;
+  result.sequence = synthetic::MakeSequence(options);
+  for (int i = 0; i < frames; ++i) {
+    cv::Mat image;
+    const synthetic::RenderedFrame frame = synthetic::RenderFrame(result.sequence, i);
+    frame.image.convertTo(image, CV_32F);
+    result.images.push_back(image);
+    if (i == 0) result.first_depth = frame.depth;
+  }
+  return result;
+}
+
+}  // namespace pldvo::test
+
+#endif  // PLDVO_TESTS_BACKEND_RENDERED_SEQUENCE_H_
