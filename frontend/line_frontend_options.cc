@@ -31,6 +31,7 @@ std::string LineMergerOptions::Check() const {
   if (max_line_distance_px < 0.0) return "merger.max_line_distance_px must be >= 0";
   if (max_gap_px < 0.0) return "merger.max_gap_px must be >= 0";
   if (min_length_px < 0.0) return "merger.min_length_px must be >= 0";
+  if (max_segments < 0) return "merger.max_segments must be >= 0";
   return "";
 }
 

@@ -103,6 +103,9 @@ struct LineMergerOptions {
   double max_gap_px = 10.0;
   // Segments shorter than this after merging are dropped (full-resolution px).
   double min_length_px = 20.0;
+  // At most this many segments are kept, the longest (0 = all): bounds the LBD and matching
+  // time on cluttered frames, and long segments are the better localised and described ones.
+  int max_segments = 150;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
@@ -115,6 +118,8 @@ struct LineMergerOptions {
     v.Field("max_gap_px", &max_gap_px, "Maximum gap between merged segments along the line (px).");
     v.Field("min_length_px", &min_length_px,
             "Segments shorter than this after merging are dropped.");
+    v.Field("max_segments", &max_segments,
+            "Keep at most this many segments, the longest (0 = all; default 150).");
   }
   std::string Check() const;
 };

@@ -48,6 +48,13 @@ struct Cluster {
   Eigen::Vector2d End() const { return origin + hi * direction; }
 };
 
+// `segments` sorted longest first: keeps the first max_segments (0 = all).
+void KeepLongest(int max_segments, std::vector<LineSegment>* segments) {
+  if (max_segments > 0 && segments->size() > static_cast<size_t>(max_segments)) {
+    segments->resize(max_segments);
+  }
+}
+
 }  // namespace
 
 LineMerger::LineMerger(const LineMergerOptions& options, double endpoint_sigma_px)
@@ -64,6 +71,7 @@ std::vector<LineSegment> LineMerger::Merge(const std::vector<LineSegment>& segme
     }
     std::sort(merged.begin(), merged.end(),
               [](const LineSegment& a, const LineSegment& b) { return a.length > b.length; });
+    KeepLongest(options_.max_segments, &merged);
     return merged;
   }
   if (segments.empty()) return merged;
@@ -170,6 +178,7 @@ std::vector<LineSegment> LineMerger::Merge(const std::vector<LineSegment>& segme
   }
   std::stable_sort(merged.begin(), merged.end(),
                    [](const LineSegment& a, const LineSegment& b) { return a.length > b.length; });
+  KeepLongest(options_.max_segments, &merged);
   return merged;
 }
 

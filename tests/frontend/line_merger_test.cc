@@ -65,6 +65,24 @@ TEST(LineMerger, DropsShortSegmentsAndCanBeDisabled) {
   EXPECT_TRUE(LineMerger(options, 0.5).Merge(segments).empty());
 }
 
+TEST(LineMerger, KeepsTheLongestMaxSegments) {
+  // Five parallel, separate segments of lengths 30..70 px: max_segments = 2 keeps the 70 and
+  // 60 px ones, longest first, with merging enabled or not; 0 keeps all five.
+  std::vector<LineSegment> segments;
+  for (int i = 0; i < 5; ++i) segments.push_back(Seg(0, 40.0 * i, 30.0 + 10.0 * i, 40.0 * i));
+  LineMergerOptions options;
+  options.max_segments = 2;
+  for (const bool enabled : {true, false}) {
+    options.enabled = enabled;
+    const std::vector<LineSegment> kept = LineMerger(options, 0.5).Merge(segments);
+    ASSERT_EQ(kept.size(), 2u);
+    EXPECT_NEAR(kept[0].length, 70.0, 1e-9);
+    EXPECT_NEAR(kept[1].length, 60.0, 1e-9);
+  }
+  options.max_segments = 0;
+  EXPECT_EQ(LineMerger(options, 0.5).Merge(segments).size(), 5u);
+}
+
 TEST(LineMerger, ManyRandomFragmentsOfFewLines) {
   // 12 random lines, each cut into 2..5 pieces with gaps <= 6 px and 0.3 px noise, shuffled;
   // merging must restore exactly 12 segments.
