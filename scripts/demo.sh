@@ -11,7 +11,7 @@ scripts/build.sh
 build=${PLDVO_BUILD_DIR:-build}
 pldvo="$build/experiments/pldvo"
 demo=${PLDVO_DEMO_DIR:-/tmp/pldvo_demo}
-frames=${PLDVO_DEMO_FRAMES:-150}
+frames=${PLDVO_DEMO_FRAMES:-300}
 mkdir -p "$demo"
 for preset in lowtex textured; do
   if [ ! -f "$demo/$preset/rgb.txt" ]; then
