@@ -1,5 +1,5 @@
-// Test helper: a short synthetic sequence (lowtex preset, seed 1, 320x240, f = 262.5, 30 fps)
-// rendered once per test process, with every frame as CV_32F and frame 0's depth.
+// Test helper: the small lowtex sequence (tests/small_lowtex_options.h) rendered, with every frame
+// as CV_32F and frame 0's depth.
 #ifndef PLDVO_TESTS_BACKEND_RENDERED_SEQUENCE_H_
 #define PLDVO_TESTS_BACKEND_RENDERED_SEQUENCE_H_
 
@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/synthetic/synthetic_sequence.h"
+#include "tests/small_lowtex_options.h"
 
 namespace pldvo::test {
 
@@ -17,14 +18,7 @@ struct RenderedSequence {
 };
 
 inline RenderedSequence RenderLowtexSequence(int frames) {
-  synthetic::SynthOptions options;
-  options.preset = "lowtex";
-  options.frames = frames;
-  options.seed = 1;
-  options.width = 320;
-  options.height = 240;
-  options.fx = options.fy = 262.5;
-  options.threads = 2;
+  const synthetic::SynthOptions options = SmallLowtexOptions(frames);
   RenderedSequence result;
   result.sequence = synthetic::MakeSequence(options);
   for (int i = 0; i < frames; ++i) {

@@ -27,6 +27,7 @@
 #include "core/synthetic/synthetic_sequence.h"
 #include "core/trajectory_io.h"
 #include "tests/experiments/test_folder.h"
+#include "tests/small_lowtex_options.h"
 
 namespace pldvo {
 namespace {
@@ -62,14 +63,7 @@ using test::TestRoot;
 fs::path Sequence(int frames) {
   const fs::path path = TestRoot() / ("lowtex_" + std::to_string(frames));
   if (!fs::exists(path)) {
-    synthetic::SynthOptions options;
-    options.preset = "lowtex";
-    options.frames = frames;
-    options.seed = 1;
-    options.width = 320;
-    options.height = 240;
-    options.fx = options.fy = 262.5;
-    options.threads = 2;
+    synthetic::SynthOptions options = test::SmallLowtexOptions(frames);
     options.supersampling = kSupersampling;
     synthetic::WriteSequence(synthetic::MakeSequence(options), path.string());
   }

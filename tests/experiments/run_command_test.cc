@@ -18,6 +18,7 @@
 #include "core/synthetic/synthetic_sequence.h"
 #include "core/trajectory_io.h"
 #include "tests/experiments/test_folder.h"
+#include "tests/small_lowtex_options.h"
 
 namespace pldvo {
 namespace {
@@ -31,14 +32,7 @@ using test::TestRoot;
 // The synthetic sequence (written once per test process).
 fs::path SequenceDir() {
   static const fs::path dir = [] {
-    synthetic::SynthOptions options;
-    options.preset = "lowtex";
-    options.frames = kFrames;
-    options.seed = 1;
-    options.width = 320;
-    options.height = 240;
-    options.fx = options.fy = 262.5;
-    options.threads = 2;
+    synthetic::SynthOptions options = test::SmallLowtexOptions(kFrames);
 #ifdef PLDVO_SANITIZE
     options.supersampling = 1;  // rendering dominates these tests under the sanitizers
 #endif

@@ -17,9 +17,11 @@
 namespace pldvo {
 namespace {
 
+using testing_utils::CompareWithTwin;
 using testing_utils::PlaceReferencePixel;
 using testing_utils::TestCamera;
 using testing_utils::TestCurFromRef;
+using testing_utils::TwinComparison;
 
 enum class Loss { kNone, kHuber, kCauchy };
 constexpr double kLossScale = 1.0;  // whitened units
@@ -186,29 +188,20 @@ TEST_F(PhotometricResidualTest, AnalyticMatchesAutoDiff) {
           new PhotometricTwin(smooth_, camera_, observations, loss_kind, interpolation),
           static_cast<int>(observations.size()));
       const int n = static_cast<int>(observations.size());
-      Eigen::VectorXd r_analytic(n), r_twin(n);
-      Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor> j_analytic(n, 7), j_twin(n, 7);
-      const double* parameters[] = {pose_};
-      double* j_analytic_ptr[] = {j_analytic.data()};
-      double* j_twin_ptr[] = {j_twin.data()};
-      ASSERT_TRUE(analytic.Evaluate(parameters, r_analytic.data(), j_analytic_ptr));
-      ASSERT_TRUE(twin.Evaluate(parameters, r_twin.data(), j_twin_ptr));
+      const TwinComparison c = CompareWithTwin(analytic, twin, pose_, n);
+      ASSERT_TRUE(c.evaluated);
       EXPECT_EQ(analytic.num_valid(), n);
-      EXPECT_LT((r_analytic - r_twin).cwiseAbs().maxCoeff(), 1e-9);
-      const PlusJacobianMatrix plus = PosePlusJacobian(pose_);
-      const Eigen::MatrixXd tangent_analytic = j_analytic * plus;
-      const Eigen::MatrixXd tangent_twin = j_twin * plus;
-      const double scale = tangent_twin.cwiseAbs().maxCoeff();
-      EXPECT_LT((tangent_analytic - tangent_twin).cwiseAbs().maxCoeff(), 1e-9 * scale)
+      EXPECT_LT(c.max_residual_difference, 1e-9);
+      EXPECT_LT(c.max_tangent_difference, 1e-9 * c.tangent_scale)
           << "loss " << static_cast<int>(loss_kind) << " interpolation "
           << static_cast<int>(interpolation);
       // EvaluateTangent gives the same rows directly.
       Eigen::VectorXd r_tangent(n);
       Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> j_tangent(n, 6);
       analytic.EvaluateTangent(cur_from_ref_, r_tangent.data(), j_tangent.data(), nullptr);
-      EXPECT_LT((r_tangent - r_analytic).cwiseAbs().maxCoeff(), 1e-12);
-      EXPECT_LT((Eigen::MatrixXd(j_tangent) - tangent_analytic).cwiseAbs().maxCoeff(),
-                1e-9 * scale);
+      EXPECT_LT((r_tangent - c.residuals).cwiseAbs().maxCoeff(), 1e-12);
+      EXPECT_LT((Eigen::MatrixXd(j_tangent) - c.tangent_jacobian).cwiseAbs().maxCoeff(),
+                1e-9 * c.tangent_scale);
     }
   }
 }

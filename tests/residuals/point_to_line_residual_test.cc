@@ -15,9 +15,11 @@
 namespace pldvo {
 namespace {
 
+using testing_utils::CompareWithTwin;
 using testing_utils::PlaceReferencePixel;
 using testing_utils::TestCamera;
 using testing_utils::TestCurFromRef;
+using testing_utils::TwinComparison;
 
 enum class Loss { kNone, kHuber, kCauchy };
 constexpr double kLossScale = 1.0;
@@ -113,20 +115,11 @@ TEST_F(PointToLineResidualTest, AnalyticMatchesAutoDiff) {
     const PointToLineResidual analytic(camera_, observations, loss.get());
     ceres::AutoDiffCostFunction<PointToLineTwin, ceres::DYNAMIC, 7> twin(
         new PointToLineTwin(camera_, observations, loss_kind), n);
-    Eigen::VectorXd r_analytic(n), r_twin(n);
-    Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor> j_analytic(n, 7), j_twin(n, 7);
-    const double* parameters[] = {pose_};
-    double* j_analytic_ptr[] = {j_analytic.data()};
-    double* j_twin_ptr[] = {j_twin.data()};
-    ASSERT_TRUE(analytic.Evaluate(parameters, r_analytic.data(), j_analytic_ptr));
-    ASSERT_TRUE(twin.Evaluate(parameters, r_twin.data(), j_twin_ptr));
+    const TwinComparison c = CompareWithTwin(analytic, twin, pose_, n);
+    ASSERT_TRUE(c.evaluated);
     EXPECT_EQ(analytic.num_valid(), n);
-    EXPECT_LT((r_analytic - r_twin).cwiseAbs().maxCoeff(), 1e-10);
-    const PlusJacobianMatrix plus = PosePlusJacobian(pose_);
-    const Eigen::MatrixXd tangent_analytic = j_analytic * plus;
-    const Eigen::MatrixXd tangent_twin = j_twin * plus;
-    EXPECT_LT((tangent_analytic - tangent_twin).cwiseAbs().maxCoeff(),
-              1e-10 * tangent_twin.cwiseAbs().maxCoeff());
+    EXPECT_LT(c.max_residual_difference, 1e-10);
+    EXPECT_LT(c.max_tangent_difference, 1e-10 * c.tangent_scale);
   }
 }
 

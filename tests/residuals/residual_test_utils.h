@@ -4,6 +4,7 @@
 #ifndef PLDVO_TESTS_RESIDUALS_RESIDUAL_TEST_UTILS_H_
 #define PLDVO_TESTS_RESIDUALS_RESIDUAL_TEST_UTILS_H_
 
+#include <ceres/cost_function.h>
 #include <ceres/jet.h>
 
 #include <Eigen/Core>
@@ -14,6 +15,7 @@
 #include "core/image_pyramid.h"
 #include "core/pinhole_camera.h"
 #include "core/se3.h"
+#include "residuals/se3_manifold.h"
 
 namespace pldvo {
 namespace testing_utils {
@@ -101,6 +103,40 @@ T CauchySqrtForm(const T& r, double a) {
   const double b = a * a;
   const T rho = T(b) * log(T(1.0) + r * r / T(b));
   return r >= T(0.0) ? sqrt(rho) : -sqrt(rho);
+}
+
+// An analytic pose cost function of n rows against its autodiff twin at one pose (7 parameters):
+// both Jacobians lifted to the tangent space, and the largest differences.
+struct TwinComparison {
+  bool evaluated = false;  // both Evaluate calls returned true
+  Eigen::VectorXd residuals;
+  Eigen::MatrixXd tangent_jacobian;  // of `analytic`, n x 6
+  double max_residual_difference = 0.0;
+  double max_tangent_difference = 0.0;
+  double tangent_scale = 0.0;  // largest |entry| of the twin's tangent Jacobian
+};
+
+inline TwinComparison CompareWithTwin(const ceres::CostFunction& analytic,
+                                      const ceres::CostFunction& twin, const double* pose, int n) {
+  TwinComparison comparison;
+  Eigen::VectorXd r_twin(n);
+  comparison.residuals.resize(n);
+  Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor> j_analytic(n, 7), j_twin(n, 7);
+  const double* parameters[] = {pose};
+  double* j_analytic_ptr[] = {j_analytic.data()};
+  double* j_twin_ptr[] = {j_twin.data()};
+  comparison.evaluated =
+      analytic.Evaluate(parameters, comparison.residuals.data(), j_analytic_ptr) &&
+      twin.Evaluate(parameters, r_twin.data(), j_twin_ptr);
+  if (!comparison.evaluated) return comparison;
+  const PlusJacobianMatrix plus = PosePlusJacobian(pose);
+  comparison.tangent_jacobian = j_analytic * plus;
+  const Eigen::MatrixXd tangent_twin = j_twin * plus;
+  comparison.max_residual_difference = (comparison.residuals - r_twin).cwiseAbs().maxCoeff();
+  comparison.max_tangent_difference =
+      (comparison.tangent_jacobian - tangent_twin).cwiseAbs().maxCoeff();
+  comparison.tangent_scale = tangent_twin.cwiseAbs().maxCoeff();
+  return comparison;
 }
 
 }  // namespace testing_utils
