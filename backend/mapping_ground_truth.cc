@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <opencv2/imgproc.hpp>
 #include <random>
 #include <stdexcept>
 
@@ -196,7 +197,42 @@ DepthErrorStats EvaluateDepthMap(const SemiDenseDepthMap& map, const cv::Mat& gt
     stats.mean_nees += nees[k] / nees.size();
   }
   stats.within_2sigma = static_cast<double>(within) / rel.size();
+  int bulk = 0;
+  for (const double e : nees) {
+    if (e > kGrossNees) continue;
+    stats.bulk_mean_nees += e;
+    ++bulk;
+  }
+  stats.gross_fraction = 1.0 - static_cast<double>(bulk) / nees.size();
+  if (bulk > 0) stats.bulk_mean_nees /= bulk;
   return stats;
+}
+
+cv::Mat ContinuousDepthMask(const cv::Mat& gt_idepth, int radius, double max_rel_step) {
+  if (gt_idepth.type() != CV_32F || radius < 0 || !(max_rel_step > 0.0)) {
+    throw std::invalid_argument("ContinuousDepthMask: CV_32F input, radius >= 0, step > 0");
+  }
+  cv::Mat step(gt_idepth.size(), CV_8U, cv::Scalar(0));
+  auto jumps = [&](float a, float b) {
+    return !(a > 0.f && b > 0.f) || std::abs(a - b) > max_rel_step * std::min(a, b);
+  };
+  for (int y = 0; y < gt_idepth.rows; ++y) {
+    for (int x = 0; x < gt_idepth.cols; ++x) {
+      const float g = gt_idepth.at<float>(y, x);
+      if (x + 1 < gt_idepth.cols && jumps(g, gt_idepth.at<float>(y, x + 1))) {
+        step.at<uint8_t>(y, x) = step.at<uint8_t>(y, x + 1) = 255;
+      }
+      if (y + 1 < gt_idepth.rows && jumps(g, gt_idepth.at<float>(y + 1, x))) {
+        step.at<uint8_t>(y, x) = step.at<uint8_t>(y + 1, x) = 255;
+      }
+    }
+  }
+  cv::Mat near_step;
+  cv::dilate(step, near_step,
+             cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * radius + 1, 2 * radius + 1)));
+  cv::Mat mask;
+  cv::bitwise_not(near_step, mask);
+  return mask;
 }
 
 }  // namespace pldvo

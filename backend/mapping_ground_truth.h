@@ -58,7 +58,19 @@ struct DepthErrorStats {
   double mean_nees = 0.0;      // mean (d - d_gt)^2 / V (1 for a consistent filter)
   double median_nees = 0.0;    // median; 0.455 for a consistent Gaussian filter
   double within_2sigma = 0.0;  // fraction with |d - d_gt| <= 2 sqrt(V) (0.954 if consistent)
+  // The mean NEES splits into gross errors, NEES > kGrossNees (the chi^2(1) 99.9% quantile; a
+  // fraction of 0.001 if consistent), and the bulk, whose mean NEES is 0.988 if consistent.
+  double gross_fraction = 0.0;
+  double bulk_mean_nees = 0.0;
 };
+constexpr double kGrossNees = 10.83;
+
+// CV_8U mask of the pixels where the GT inverse depth (CV_32F, 0 = none) is continuous: 255 unless
+// a pixel within `radius` (a square window) has a 4-neighbour step larger than max_rel_step times
+// its inverse depth or lies next to a pixel without depth. At occlusion boundaries the GT of a
+// pixel is one of two surfaces while its stereo patch sees both, so per-pixel errors there measure
+// the boundary's sub-pixel position rather than the filter.
+cv::Mat ContinuousDepthMask(const cv::Mat& gt_idepth, int radius, double max_rel_step);
 
 // Statistics over the valid hypotheses with gt_idepth > 0 (CV_32F) and mask != 0 (CV_8U; empty =
 // everywhere); with require_observed only hypotheses with at least one stereo observation.

@@ -27,6 +27,11 @@ struct MapEvalConfig {
   // Further line-guided runs, one per endpoint noise (the accuracy crossover with photometric).
   std::vector<double> line_sigma_sweep = {0.1, 0.5, 1.0};
   int line_seed = 17;
+  // ContinuousDepthMask: a GT inverse-depth step larger than this fraction between 4-neighbours
+  // is a discontinuity; pixels within discontinuity_radius_px of one are left out of
+  // `continuous` (3 = the 5-sample SSD's half-length plus the bilinear interpolation pixel).
+  double discontinuity_rel_step = 0.02;
+  int discontinuity_radius_px = 3;
   // When not empty: the line-guided keyframe map is written there (inverse-depth PNGs raw and
   // regularised, PLY point cloud). Not a config key.
   std::string out_dir;
@@ -42,6 +47,10 @@ struct MapEvalConfig {
     v.Field("frame_stride", &frame_stride, "Frame k is keyframe_index + k * frame_stride.");
     v.Field("line_sigma_px", &line_sigma_px, "Endpoint noise of the GT current lines, pixels.");
     v.Field("line_seed", &line_seed, "Seed of that noise.");
+    v.Field("discontinuity_rel_step", &discontinuity_rel_step,
+            "GT inverse-depth step between neighbours that is a discontinuity (fraction).");
+    v.Field("discontinuity_radius_px", &discontinuity_radius_px,
+            "Pixels this close to a GT discontinuity are not `continuous`.");
     v.Field("line_sigma_sweep", &line_sigma_sweep,
             "Endpoint noises of additional line-guided runs, pixels.");
     v.Section("synth", &synth, "Synthetic sequence.");
@@ -52,8 +61,9 @@ struct MapEvalConfig {
 
 // One mapping run (one stereo variant) and its evaluation.
 struct MapEvalRun {
-  DepthErrorStats all;    // every observed hypothesis vs the GT depth image
-  DepthErrorStats edges;  // observed hypotheses on edge centre pixels vs the GT 3D line
+  DepthErrorStats all;         // every observed hypothesis vs the GT depth image
+  DepthErrorStats continuous;  // `all` away from GT depth discontinuities (ContinuousDepthMask)
+  DepthErrorStats edges;       // observed hypotheses on edge centre pixels vs the GT 3D line
   DepthErrorStats edges_line_regularized;  // the same after the 3D line regularisation
   DepthErrorStats all_smoothed;            // `all` after the inverse-variance smoothing
   LineRegularizationStats line_stats;
