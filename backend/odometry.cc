@@ -74,6 +74,13 @@ Odometry::Odometry(const PinholeCamera& camera, const OdometryConfig& config,
   const std::string error = config.Check();
   if (!error.empty()) throw std::invalid_argument("Odometry: config: " + error);
   if (config_.odometry.use_lines) frontend_ = std::make_unique<LineFrontend>(config_.lines);
+  if (config_.odometry.compare_solver != OdometryOptions::CompareSolver::kNone) {
+    TrackingOptions compare = config_.tracking;
+    compare.solver.type = config_.odometry.compare_solver == OdometryOptions::CompareSolver::kCeres
+                              ? SolverOptions::Type::kCeres
+                              : SolverOptions::Type::kGaussNewton;
+    compare_tracker_ = std::make_unique<Tracker>(compare);
+  }
   mapper_ = std::make_unique<MappingWorker>(
       camera_, config_.mapping, config_.odometry.parallel_mapping,
       config_.odometry.mapping_queue_size, config_.odometry.wait_for_mapping);
@@ -118,7 +125,7 @@ OdometryFrameResult Odometry::ProcessFrame(int index, double timestamp, const cv
   } catch (const std::exception& e) {
     return SkipFrame(index, timestamp, std::string("processing failed: ") + e.what());
   }
-  result.timing.tracking_thread_ms = MsSince(start);
+  result.timing.tracking_thread_ms = MsSince(start) - result.timing.compare_tracking_ms;
   return Finalize(std::move(result));
 }
 
@@ -418,6 +425,15 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, const cv::Mat
       }
     }
     timing.tracking_ms = MsSince(start);
+    if (compare_tracker_ != nullptr && tracking.status != TrackingStatus::kLost) {
+      start = Clock::now();
+      const TrackingResult other =
+          compare_tracker_->Track(reference_, pyramid, tracking.initial_cur_from_ref);
+      timing.compare_tracking_ms = MsSince(start);
+      result.compared = true;
+      result.compared_status = other.status;
+      result.world_from_cam_compared = keyframe_.world_from_kf * other.cur_from_ref.Inverse();
+    }
 
     if (tracking.status != TrackingStatus::kLost) {
       const SE3 cur_from_kf = tracking.cur_from_ref;

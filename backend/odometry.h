@@ -139,6 +139,7 @@ class Odometry {
   OdometryObserver* observer_;
   std::unique_ptr<LineFrontend> frontend_;
   Tracker tracker_;
+  std::unique_ptr<Tracker> compare_tracker_;  // odometry.compare_solver, else null
   std::unique_ptr<MappingWorker> mapper_;
   // Edge BA (null when disabled); the adjuster only in parallel mode.
   std::unique_ptr<KeyframeWindow> edge_ba_window_;

@@ -107,6 +107,12 @@ struct OdometryOptions {
   // first frame's depth image (TUM layout: 16-bit PNG, metres x 5000) with this inverse-depth
   // variance, which fixes the scale and removes the monocular initialisation; 0 = off.
   double init_depth_idepth_var = 0.0;
+  // Solver comparison (docs/tracking.md): every tracked frame's final tracking problem (the same
+  // reference, lines and initial pose) is solved a second time with this solver; its poses, RPE
+  // and time are reported beside the run's (summary.json `compare_solver`,
+  // trajectory_compare.txt) and do not influence the run. Not counted in tracking_thread.
+  enum class CompareSolver { kNone, kCeres, kGaussNewton };
+  CompareSolver compare_solver = CompareSolver::kNone;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
@@ -140,6 +146,12 @@ struct OdometryOptions {
     v.Field("init_depth_idepth_var", &init_depth_idepth_var,
             "Evaluation aid: > 0 initialises the first keyframe from the dataset's depth image "
             "with this inverse-depth variance, (1/m)^2; 0 = monocular random init (default).");
+    v.Choice("compare_solver", &compare_solver,
+             ChoiceNames<CompareSolver>{{"none", CompareSolver::kNone},
+                                        {"ceres", CompareSolver::kCeres},
+                                        {"gauss_newton", CompareSolver::kGaussNewton}},
+             "Also solve every frame's tracking problem with this solver and report the "
+             "difference: none | ceres | gauss_newton (default none).");
   }
   std::string Check() const;
 };

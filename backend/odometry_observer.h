@@ -46,6 +46,8 @@ struct OdometryTiming {
   // Everything ProcessFrame does on the calling thread (with inline mapping this includes the
   // mapping job).
   double tracking_thread_ms = 0.0;
+  // The comparison solve (odometry.compare_solver); not included in tracking_thread_ms.
+  double compare_tracking_ms = 0.0;
 };
 
 struct OdometryFrameResult {
@@ -63,6 +65,11 @@ struct OdometryFrameResult {
   double mean_idepth = 0.0;      // of the keyframe map
   OdometryTiming timing;
   std::string message;  // why a frame is lost / failed
+  // odometry.compare_solver: the same final tracking problem solved by the other solver, and the
+  // wall time of the run's final solve (TrackingResult::ms of `tracking`) vs the other's.
+  bool compared = false;
+  TrackingStatus compared_status = TrackingStatus::kLost;
+  SE3 world_from_cam_compared;  // its pose, with this run's keyframe pose
 };
 
 // A keyframe whose map is final (replaced by a new keyframe, or the last one at Finish).

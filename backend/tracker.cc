@@ -1,6 +1,7 @@
 #include "backend/tracker.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -125,7 +126,9 @@ TrackingResult Tracker::Track(const TrackingReference& reference, const ImagePyr
 
   double pose[kPoseAmbientSize];
   PoseToParameters(initial_cur_from_ref, pose);
+  const auto start = std::chrono::steady_clock::now();
   TrackingResult result;
+  result.initial_cur_from_ref = initial_cur_from_ref;
   for (int level = coarsest; level >= options_.finest_level; --level) {
     LeastSquaresProblem problem;
     const BuildStatistics built = builder_->Build(reference, current, level, pose, &problem);
@@ -184,6 +187,8 @@ TrackingResult Tracker::Track(const TrackingReference& reference, const ImagePyr
   } else {
     result.status = finest.converged ? TrackingStatus::kConverged : TrackingStatus::kNotConverged;
   }
+  result.ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
 

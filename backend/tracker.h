@@ -90,6 +90,8 @@ struct LevelResult {
 
 struct TrackingResult {
   SE3 cur_from_ref;
+  SE3 initial_cur_from_ref;  // the initial guess this result was solved from
+  double ms = 0.0;           // wall time of the Track call
   TrackingStatus status = TrackingStatus::kLost;
   std::vector<LevelResult> levels;  // in the order solved (coarse to fine)
   int valid_residuals = 0;          // at the final pose, finest level

@@ -8,7 +8,9 @@
 //                        frame, flushed per line (a crash never loses what was written);
 //   OUT/timing.csv       one row per frame: status, counts and the time of every component;
 //   OUT/summary.json     at the end: counts, median / mean ms per component, and with ground
-//                        truth rpe_cm_s, rpe_deg_s, ate_m, coverage (Sim(3)-aligned).
+//                        truth rpe_cm_s, rpe_deg_s, ate_m, coverage (Sim(3)-aligned);
+//   OUT/trajectory_compare.txt  with odometry.compare_solver: the other solver's poses on the
+//                        same tracking problems (summary.json `compare_solver`).
 // A frame that fails to load is reported with its file, marked failed and skipped. Exit codes
 // (docs/reliability.md): 0 done; 1 a fatal input or output fault (dataset files, camera, output
 // folder, a failed write, no frame tracked at all); 2 a usage or config error.
@@ -43,6 +45,7 @@
 #include "experiments/command.h"
 #include "experiments/common_flags.h"
 #include "experiments/run_outputs.h"
+#include "experiments/solver_comparison.h"
 
 DEFINE_int32(max_frames, 0, "Process only the first N frames (0 = all).");
 DEFINE_bool(progress, true, "Show a progress bar when stderr is a terminal.");
@@ -219,6 +222,18 @@ int RunOdometryCommand(const CommandContext& context) {
     return 1;
   }
 
+  std::unique_ptr<SolverComparison> comparison;
+  if (config.odometry.compare_solver != OdometryOptions::CompareSolver::kNone) {
+    comparison = std::make_unique<SolverComparison>(
+        out + "/trajectory_compare.txt",
+        config.odometry.compare_solver == OdometryOptions::CompareSolver::kCeres ? "ceres"
+                                                                                 : "gauss_newton");
+    if (!comparison->ok()) {
+      std::cerr << "pldvo run: cannot write into " << out << "\n";
+      return 1;
+    }
+  }
+
   ProgressBar progress(num_frames, FLAGS_progress && isatty(STDERR_FILENO));
   std::vector<TimingRow> rows;
   Trajectory estimate;
@@ -257,6 +272,11 @@ int RunOdometryCommand(const CommandContext& context) {
       WriteTumLine(pose, trajectory_file);
       if (!written(trajectory_file, "trajectory.txt")) return 1;
       estimate.push_back(pose);
+    }
+    if (comparison != nullptr && !comparison->Add(result)) {
+      std::cerr << "\npldvo run: cannot write " << out
+                << "/trajectory_compare.txt: " << std::strerror(errno) << "; stopping\n";
+      return 1;
     }
     TimingRow row;
     const OdometryTiming& t = result.timing;
@@ -351,6 +371,11 @@ int RunOdometryCommand(const CommandContext& context) {
       evaluation_line = std::string("evaluation failed: ") + e.what();
     }
   }
+  std::string comparison_line;
+  if (comparison != nullptr) {
+    summary["compare_solver"] = comparison->Summary(ground_truth);
+    comparison_line = comparison->Line(summary["compare_solver"]);
+  }
   {
     std::ofstream summary_file(out + "/summary.json");
     summary_file << summary.dump(2) << "\n";
@@ -371,6 +396,7 @@ int RunOdometryCommand(const CommandContext& context) {
               << mean[key].get<double>() << "\n";
   }
   if (!evaluation_line.empty()) std::cout << "  " << evaluation_line << "\n";
+  if (!comparison_line.empty()) std::cout << "  " << comparison_line << "\n";
   std::cout << "  outputs in " << out << "\n";
   if (num_frames > 0 && stats.tracked == 0) {
     std::cerr << "pldvo run: no frame was tracked (" << failed

@@ -1,0 +1,94 @@
+#include "experiments/solver_comparison.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+
+#include "core/evaluation.h"
+
+namespace pldvo {
+namespace {
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+double Max(const std::vector<double>& values) {
+  return values.empty() ? 0.0 : *std::max_element(values.begin(), values.end());
+}
+
+}  // namespace
+
+SolverComparison::SolverComparison(const std::string& path, const std::string& solver_name)
+    : file_(path), solver_name_(solver_name) {
+  file_ << "# pldvo run, odometry.compare_solver=" << solver_name
+        << ": timestamp tx ty tz qx qy qz qw (world_from_cam)\n";
+  file_.flush();
+}
+
+bool SolverComparison::Add(const OdometryFrameResult& result) {
+  if (!IsTracked(result.status)) return true;
+  const SE3& pose = result.compared ? result.world_from_cam_compared : result.world_from_cam;
+  if (result.compared) {
+    // Against the pose the run reports (for a new keyframe after a synchronous edge BA, the
+    // refined one).
+    const SE3 difference = result.world_from_cam.Inverse() * result.world_from_cam_compared;
+    translation_diff_m_.push_back(difference.translation().norm());
+    rotation_diff_deg_.push_back(180.0 / M_PI * Eigen::AngleAxisd(difference.rotation()).angle());
+    run_tracking_ms_.push_back(result.tracking.ms);
+    compare_tracking_ms_.push_back(result.timing.compare_tracking_ms);
+    lost_ += result.compared_status == TrackingStatus::kLost;
+  }
+  trajectory_.push_back({result.timestamp, pose});
+  WriteTumLine(trajectory_.back(), file_);
+  return static_cast<bool>(file_.flush());
+}
+
+nlohmann::json SolverComparison::Summary(const Trajectory* ground_truth) const {
+  nlohmann::json summary;
+  summary["solver"] = solver_name_;
+  summary["frames_compared"] = translation_diff_m_.size();
+  summary["frames_lost"] = lost_;
+  summary["translation_diff_m_median"] = Median(translation_diff_m_);
+  summary["translation_diff_m_max"] = Max(translation_diff_m_);
+  summary["rotation_diff_deg_median"] = Median(rotation_diff_deg_);
+  summary["rotation_diff_deg_max"] = Max(rotation_diff_deg_);
+  summary["tracking_ms_median"] = Median(compare_tracking_ms_);
+  summary["run_tracking_ms_median"] = Median(run_tracking_ms_);
+  if (ground_truth != nullptr && !ground_truth->empty()) {
+    try {
+      const EvaluationResult eval = EvaluateTrajectory(*ground_truth, trajectory_);
+      summary["rpe_cm_s"] = std::isfinite(eval.rpe_cm_s) ? nlohmann::json(eval.rpe_cm_s) : nullptr;
+      summary["rpe_deg_s"] =
+          std::isfinite(eval.rpe_deg_s) ? nlohmann::json(eval.rpe_deg_s) : nullptr;
+      summary["ate_m"] = eval.ate_m;
+    } catch (const std::exception& e) {
+      summary["evaluation_error"] = e.what();
+    }
+  }
+  return summary;
+}
+
+std::string SolverComparison::Line(const nlohmann::json& s) const {
+  char line[512];
+  std::snprintf(line, sizeof(line),
+                "compare %s on the same problems: %d frames (%d lost), pose difference median "
+                "%.2e m / %.2e deg, max %.2e m / %.2e deg; tracking median %.2f ms (run %.2f ms)",
+                solver_name_.c_str(), s["frames_compared"].get<int>(), lost_,
+                s["translation_diff_m_median"].get<double>(),
+                s["rotation_diff_deg_median"].get<double>(),
+                s["translation_diff_m_max"].get<double>(), s["rotation_diff_deg_max"].get<double>(),
+                s["tracking_ms_median"].get<double>(), s["run_tracking_ms_median"].get<double>());
+  std::string text = line;
+  if (s.contains("rpe_cm_s") && s["rpe_cm_s"].is_number()) {
+    std::snprintf(line, sizeof(line), "; RPE %.3f cm/s, ATE %.4f m", s["rpe_cm_s"].get<double>(),
+                  s["ate_m"].get<double>());
+    text += line;
+  }
+  return text;
+}
+
+}  // namespace pldvo
