@@ -1,12 +1,16 @@
 // `pldvo ablate --configs A.yaml,B.yaml --datasets DIR1,DIR2 --out OUT [--jobs N] [--shard i/N]
-//              [--set key=value]...`: `pldvo run` for every (dataset, config) pair, each in its
-// own subprocess of this binary (a crash or hang of one run cannot take the others down), N at
-// a time. Pair k (dataset-major order) belongs to shard k mod N. Per pair:
-// OUT/runs/<dataset>__<config>/ holds the run's outputs and log.txt. Then, over the whole grid
-// (pairs of other shards count when their summary.json exists in OUT):
-//   OUT/results.csv                  one row per pair (status, counts, RPE, ATE, timing);
-//   OUT/results.md                   RPE tables like the paper's Tables I/II (X: failed run);
-//   OUT/trajectories_<dataset>.svg   top view, Sim(3)-aligned estimates against ground truth.
+//              [--repeats R] [--set key=value]...`: `pldvo run` for every (dataset, config)
+// pair, each in its own subprocess of this binary (a crash or hang of one run cannot take the
+// others down), N at a time. With --repeats R every pair runs R times, repeat k with
+// mapping.init_seed = k (the monocular random initial map; docs/odometry.md). Run k (dataset,
+// config, repeat order) belongs to shard k mod N. Per run: OUT/runs/<dataset>__<config>/ (with
+// R > 1: .../<dataset>__<config>__seed<k>/) holds the run's outputs and log.txt. Then, over the
+// whole grid (runs of other shards count when their summary.json exists in OUT):
+//   OUT/results.csv                  one row per run (status, counts, RPE, ATE, timing);
+//   OUT/results.md                   RPE tables like the paper's Tables I/II (X: failed run;
+//                                    with R > 1 the median and [min, max] over the repeats);
+//   OUT/trajectories_<dataset>.svg   top view, Sim(3)-aligned estimates (repeat 1) against
+//                                    ground truth.
 // --set overrides are passed to every run. Exit status 0 when every run of this shard succeeded.
 #include <fcntl.h>
 #include <gflags/gflags.h>
@@ -14,6 +18,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <exception>
@@ -42,6 +47,8 @@ DEFINE_string(datasets, "", "Comma-separated dataset folders (one row each).");
 DEFINE_int32(jobs, 1, "Runs in parallel (each a subprocess).");
 DEFINE_string(shard, "0/1", "i/N: run only the pairs k with k mod N == i.");
 DEFINE_bool(skip_existing, false, "Do not rerun pairs whose summary.json exists.");
+DEFINE_int32(repeats, 1,
+             "Runs per pair; repeat k sets mapping.init_seed=k. Tables: median [min, max].");
 
 namespace pldvo {
 namespace {
@@ -80,6 +87,7 @@ struct Pair {
   int index = 0;
   int dataset = 0;
   int config = 0;
+  int repeat = 1;  // 1..repeats; with repeats > 1 also the run's mapping.init_seed
   std::string dir;
   bool ran = false;
   int exit_code = -1;  // of this invocation's run; -1 when not run here
@@ -132,6 +140,12 @@ double JsonNumber(const nlohmann::json& json, const char* key) {
   return std::nan("");
 }
 
+double Median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
 std::string Fixed(double value, int precision) {
   if (!std::isfinite(value)) return "";
   std::ostringstream out;
@@ -157,6 +171,10 @@ int RunAblate(const CommandContext& context) {
       return 2;
     }
   }
+  if (FLAGS_repeats < 1) {
+    std::cerr << "pldvo ablate: --repeats must be >= 1, got " << FLAGS_repeats << "\n";
+    return 2;
+  }
   for (const std::string& config : configs) {
     if (!std::filesystem::exists(config)) {
       std::cerr << "pldvo ablate: config file " << config << " does not exist\n";
@@ -169,14 +187,19 @@ int RunAblate(const CommandContext& context) {
   const std::vector<std::string> dataset_names = UniqueNames(datasets);
 
   std::vector<Pair> pairs;
+  const int repeats = FLAGS_repeats;
   for (size_t d = 0; d < datasets.size(); ++d) {
     for (size_t c = 0; c < configs.size(); ++c) {
-      Pair pair;
-      pair.index = static_cast<int>(pairs.size());
-      pair.dataset = static_cast<int>(d);
-      pair.config = static_cast<int>(c);
-      pair.dir = out + "/runs/" + dataset_names[d] + "__" + config_names[c];
-      pairs.push_back(pair);
+      for (int r = 1; r <= repeats; ++r) {
+        Pair pair;
+        pair.index = static_cast<int>(pairs.size());
+        pair.dataset = static_cast<int>(d);
+        pair.config = static_cast<int>(c);
+        pair.repeat = r;
+        pair.dir = out + "/runs/" + dataset_names[d] + "__" + config_names[c];
+        if (repeats > 1) pair.dir += "__seed" + std::to_string(r);
+        pairs.push_back(pair);
+      }
     }
   }
   std::vector<Pair*> mine;
@@ -210,6 +233,9 @@ int RunAblate(const CommandContext& context) {
       for (const std::string& set : context.config_overrides) {
         args.insert(args.end(), {"--set", set});
       }
+      if (repeats > 1) {
+        args.insert(args.end(), {"--set", "mapping.init_seed=" + std::to_string(pair.repeat)});
+      }
       const auto start = std::chrono::steady_clock::now();
       pair.exit_code = RunProcess(args, pair.dir + "/log.txt");
       pair.ran = true;
@@ -217,7 +243,8 @@ int RunAblate(const CommandContext& context) {
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       std::lock_guard<std::mutex> lock(print_mutex);
       std::cout << "pldvo ablate: " << dataset_names[pair.dataset] << " x "
-                << config_names[pair.config] << ": "
+                << config_names[pair.config]
+                << (repeats > 1 ? " seed " + std::to_string(pair.repeat) : std::string()) << ": "
                 << (pair.exit_code == 0 ? "ok"
                                         : "FAILED (exit " + std::to_string(pair.exit_code) +
                                               ", see " + pair.dir + "/log.txt)")
@@ -247,7 +274,7 @@ int RunAblate(const CommandContext& context) {
   {
     std::ofstream csv(out + "/results.csv");
     csv << "dataset,config,status,frames,tracked,keyframes,lost_events,rpe_cm_s,rpe_deg_s,ate_m,"
-           "coverage,ms_median_tracking_thread,ms_median_total,dir\n";
+           "coverage,ms_median_tracking_thread,ms_median_total,init_seed,dir\n";
     for (const Pair& pair : pairs) {
       const nlohmann::json& s = summaries[pair.index];
       auto integer = [&](const char* key) {
@@ -262,7 +289,8 @@ int RunAblate(const CommandContext& context) {
           << Fixed(JsonNumber(s, "rpe_cm_s"), 4) << "," << Fixed(JsonNumber(s, "rpe_deg_s"), 4)
           << "," << Fixed(JsonNumber(s, "ate_m"), 5) << "," << Fixed(JsonNumber(s, "coverage"), 3)
           << "," << Fixed(JsonNumber(ms, "tracking_thread"), 2) << ","
-          << Fixed(JsonNumber(ms, "total"), 2) << "," << pair.dir << "\n";
+          << Fixed(JsonNumber(ms, "total"), 2) << ","
+          << (repeats > 1 ? std::to_string(pair.repeat) : std::string()) << "," << pair.dir << "\n";
     }
   }
   {
@@ -276,21 +304,41 @@ int RunAblate(const CommandContext& context) {
       for (size_t d = 0; d < datasets.size(); ++d) {
         md << "| " << dataset_names[d] << " |";
         for (size_t c = 0; c < configs.size(); ++c) {
-          const int k = static_cast<int>(d * configs.size() + c);
-          const std::string& status = statuses[k];
+          // The repeats of (d, c), and what each shows.
+          std::vector<double> values;
+          int failed = 0, not_run = 0, lost = 0;
+          for (int r = 0; r < repeats; ++r) {
+            const int k = static_cast<int>((d * configs.size() + c) * repeats + r);
+            const std::string& status = statuses[k];
+            if (status == "not_run") {
+              ++not_run;
+            } else if (status != "ok") {
+              ++failed;
+            } else {
+              const nlohmann::json& s = summaries[k];
+              const double value = std::string(key) == "ms"
+                                       ? JsonNumber(s["ms_median"], "tracking_thread")
+                                       : JsonNumber(s, key);
+              if (std::isfinite(value)) values.push_back(value);
+              const double lost_events = JsonNumber(s, "lost_events");
+              if (std::isfinite(lost_events)) lost += static_cast<int>(lost_events);
+            }
+          }
           std::string cell;
-          if (status == "not_run") {
+          if (not_run == repeats) {
             cell = "-";
-          } else if (status != "ok") {
+          } else if (values.empty()) {
             cell = "X";
           } else {
-            const nlohmann::json& s = summaries[k];
-            cell = std::string(key) == "ms"
-                       ? Fixed(JsonNumber(s["ms_median"], "tracking_thread"), precision)
-                       : Fixed(JsonNumber(s, key), precision);
-            const double lost = JsonNumber(s, "lost_events");
-            if (std::string(key) == "rpe_cm_s" && std::isfinite(lost) && lost > 0) {
-              cell += " (" + std::to_string(static_cast<int>(lost)) + " lost)";
+            cell = Fixed(Median(values), precision);
+            if (repeats > 1) {
+              cell += " [" + Fixed(*std::min_element(values.begin(), values.end()), precision) +
+                      ", " + Fixed(*std::max_element(values.begin(), values.end()), precision) +
+                      "]";
+            }
+            if (failed > 0) cell += " (" + std::to_string(failed) + " X)";
+            if (std::string(key) == "rpe_cm_s" && lost > 0) {
+              cell += " (" + std::to_string(lost) + " lost)";
             }
           }
           md << " " << cell << " |";
@@ -301,7 +349,13 @@ int RunAblate(const CommandContext& context) {
     };
     md << "## Ablation results\n\nX: the run failed (crashed, exited non-zero or too few poses to "
           "evaluate); -: not run in this shard. Sim(3)-aligned, RPE over 1 s intervals "
-          "(docs/evaluation.md). Per-run outputs in runs/<sequence>__<config>/.\n\n";
+          "(docs/evaluation.md). Per-run outputs in runs/<sequence>__<config>/.";
+    if (repeats > 1) {
+      md << " Each cell: the median and [min, max] over " << repeats
+         << " runs with mapping.init_seed = 1.." << repeats
+         << " (runs/<sequence>__<config>__seed<k>/).";
+    }
+    md << "\n\n";
     table("RPE translation (cm/s)", "rpe_cm_s", 2);
     table("RPE rotation (deg/s)", "rpe_deg_s", 3);
     table("ATE (m)", "ate_m", 4);
@@ -323,7 +377,7 @@ int RunAblate(const CommandContext& context) {
       }
       std::vector<SvgCurve> curves;
       for (size_t c = 0; c < configs.size(); ++c) {
-        const Pair& pair = pairs[d * configs.size() + c];
+        const Pair& pair = pairs[(d * configs.size() + c) * repeats];
         if (!std::filesystem::exists(pair.dir + "/trajectory.txt")) continue;
         Trajectory estimate;
         try {

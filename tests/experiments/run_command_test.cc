@@ -194,5 +194,33 @@ TEST(AblateCommandTest, TinyGridWritesTablesAndPlot) {
       << Slurp(out2 / "results.md");
 }
 
+TEST(AblateCommandTest, RepeatsRunEachPairWithItsOwnInitSeed) {
+  // Monocular runs from a random initial map: --repeats 2 runs the pair with mapping.init_seed 1
+  // and 2 and the table gives the median and [min, max].
+  const fs::path config = fs::path(PLDVO_SOURCE_DIR) / "experiments" / "configs" / "sdvo.yaml";
+  const fs::path out = TestRoot() / "ablate_repeats";
+  const fs::path log = TestRoot() / "ablate_repeats.log";
+  ASSERT_EQ(Pldvo("ablate --configs " + config.string() + " --datasets " + SequenceDir().string() +
+                      " --out " + out.string() + " --repeats 2 --jobs 2" + kDeterministic,
+                  log),
+            0)
+      << Slurp(log);
+  EXPECT_EQ(CountLines(out / "results.csv", false), 3);
+  for (const int seed : {1, 2}) {
+    const fs::path run = out / "runs" / ("lowtex__sdvo__seed" + std::to_string(seed));
+    const std::string effective = Slurp(run / "config.yaml");
+    EXPECT_NE(effective.find("init_seed: " + std::to_string(seed)), std::string::npos) << effective;
+    EXPECT_TRUE(fs::exists(run / "summary.json"));
+  }
+  const std::string md = Slurp(out / "results.md");
+  EXPECT_NE(md.find("median and [min, max] over 2 runs"), std::string::npos) << md;
+  EXPECT_NE(md.find("| lowtex | "), std::string::npos) << md;
+  EXPECT_NE(md.find("] |"), std::string::npos) << md;
+  EXPECT_EQ(Pldvo("ablate --configs " + config.string() + " --datasets " + SequenceDir().string() +
+                      " --out " + out.string() + " --repeats 0",
+                  log),
+            2);
+}
+
 }  // namespace
 }  // namespace pldvo
