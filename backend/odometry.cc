@@ -68,7 +68,11 @@ const char* FrameStatusName(FrameStatus status) {
 
 Odometry::Odometry(const PinholeCamera& camera, const OdometryConfig& config,
                    OdometryObserver* observer)
-    : camera_(camera), config_(config), observer_(observer), tracker_(config.tracking) {
+    : camera_(camera),
+      config_(config),
+      observer_(observer),
+      tracker_(config.tracking),
+      retry_trigger_(config.odometry.retry_rms_ratio) {
   const std::string camera_error = camera.Check();
   if (!camera_error.empty()) throw std::invalid_argument("Odometry: camera: " + camera_error);
   const std::string error = config.Check();
@@ -320,10 +324,7 @@ TrackingResult Odometry::TrackWithAlternatives(const ImagePyramid& pyramid, cons
   TrackingResult best = tracker_.Track(reference_, pyramid, prior_cur_from_kf, callback);
   *tried = 1;
   const OdometryOptions& options = config_.odometry;
-  const bool high_rms = rms_mean_ > 0.0 && best.final_rms > options.retry_rms_ratio * rms_mean_;
-  if (!options.try_alternatives || (best.status != TrackingStatus::kLost && !high_rms)) {
-    return best;
-  }
+  if (!options.try_alternatives || !retry_trigger_.ShouldRetry(best)) return best;
   const double angle = options.alternative_rotation_deg * M_PI / 180.0;
   std::vector<SE3> guesses = {last_good_cur_from_kf};
   const Eigen::Vector3d axes[] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY()};
@@ -443,7 +444,7 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, const cv::Mat
                            static_cast<double>(frames));
       world_from_last_good_ = world_from_cur;
       last_good_index_ = index;
-      rms_mean_ = rms_mean_ > 0.0 ? 0.9 * rms_mean_ + 0.1 * tracking.final_rms : tracking.final_rms;
+      retry_trigger_.Update(tracking);
       result.world_from_cam = world_from_cur;
       result.status = recovering_ ? FrameStatus::kRecovered : FrameStatus::kTracked;
       consecutive_lost_ = 0;

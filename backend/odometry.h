@@ -35,6 +35,7 @@
 #include "backend/mapping_worker.h"
 #include "backend/odometry_config.h"
 #include "backend/odometry_observer.h"
+#include "backend/retry_trigger.h"
 #include "backend/tracker.h"
 #include "core/image_pyramid.h"
 #include "core/pinhole_camera.h"
@@ -159,7 +160,7 @@ class Odometry {
   SE3 world_from_last_good_;
   int last_good_index_ = -1;
   SE3 velocity_;
-  double rms_mean_ = 0.0;  // running mean of the final RMS of good frames
+  RetryTrigger retry_trigger_;
   int consecutive_lost_ = 0;
   bool recovering_ = false;   // a frame was lost since the last tracked one
   bool last_tracked_ = true;  // the previous frame was tracked (lost-event counting)

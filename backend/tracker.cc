@@ -77,23 +77,25 @@ ResidualStatistics EvaluateResidualStatistics(const LeastSquaresProblem& problem
     }
     double sq_norm = 0.0;
     for (int i = 0; i < rows; ++i) sq_norm += residuals[i] * residuals[i];
+    double block_cost = 0.5 * sq_norm;
     if (block.loss_function != nullptr) {
       double rho[3];
       block.loss_function->Evaluate(sq_norm, rho);
-      stats.cost += 0.5 * rho[0];
-    } else {
-      stats.cost += 0.5 * sq_norm;
+      block_cost = 0.5 * rho[0];
     }
+    stats.cost += block_cost;
     stats.rows += rows;
     // valid(i) reflects the Evaluate above.
     const auto* photometric = dynamic_cast<const PhotometricResidual*>(block.cost_function);
     const auto* line = dynamic_cast<const PointToLineResidual*>(block.cost_function);
+    if (photometric != nullptr) stats.photometric_cost += block_cost;
     for (int i = 0; i < rows; ++i) {
       const bool valid = photometric != nullptr ? photometric->valid(i)
                          : line != nullptr      ? line->valid(i)
                                                 : true;
       if (!valid) continue;
       ++stats.valid_rows;
+      stats.photometric_valid_rows += photometric != nullptr;
       double magnitude = std::abs(residuals[i]);
       if (block.loss_function != nullptr) {
         double rho[3];
@@ -170,6 +172,10 @@ TrackingResult Tracker::Track(const TrackingReference& reference, const ImagePyr
     level_result.rms = final_stats.valid_rows > 0
                            ? std::sqrt(2.0 * final_stats.cost / final_stats.valid_rows)
                            : 0.0;
+    level_result.photometric_rms =
+        final_stats.photometric_valid_rows > 0
+            ? std::sqrt(2.0 * final_stats.photometric_cost / final_stats.photometric_valid_rows)
+            : 0.0;
     result.levels.push_back(level_result);
   }
 
@@ -177,6 +183,7 @@ TrackingResult Tracker::Track(const TrackingReference& reference, const ImagePyr
   const LevelResult& finest = result.levels.back();
   result.valid_residuals = finest.valid_rows;
   result.final_rms = finest.rms;
+  result.final_photometric_rms = finest.photometric_rms;
   result.inlier_fraction =
       finest.valid_rows > 0 ? static_cast<double>(finest.inlier_rows) / finest.valid_rows : 0.0;
   const bool lost = finest.valid_rows < std::max(1, options_.min_valid_residuals) ||

@@ -83,7 +83,8 @@ struct LevelResult {
   int inlier_rows = 0;    // valid with |r~| <= inlier_threshold
   double initial_cost = 0.0;
   double final_cost = 0.0;
-  double rms = 0.0;  // sqrt(2 final_cost / valid_rows)
+  double rms = 0.0;              // sqrt(2 final_cost / valid_rows)
+  double photometric_rms = 0.0;  // the same over the photometric rows (0 without any)
   bool converged = false;
   std::string solver_message;
 };
@@ -97,6 +98,7 @@ struct TrackingResult {
   int valid_residuals = 0;          // at the final pose, finest level
   double inlier_fraction = 0.0;     // inlier_rows / valid_rows at the finest level
   double final_rms = 0.0;
+  double final_photometric_rms = 0.0;  // finest level, photometric rows only (0 without any)
   int TotalIterations() const;
 };
 
@@ -140,6 +142,9 @@ struct ResidualStatistics {
   int valid_rows = 0;
   int inlier_rows = 0;
   double cost = 0.0;
+  // The PhotometricResidual blocks alone.
+  int photometric_valid_rows = 0;
+  double photometric_cost = 0.0;
 };
 ResidualStatistics EvaluateResidualStatistics(const LeastSquaresProblem& problem,
                                               double inlier_threshold);

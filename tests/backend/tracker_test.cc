@@ -393,6 +393,29 @@ INSTANTIATE_TEST_SUITE_P(
                                                                                  : "_bilinear");
     });
 
+// The photometric RMS (odometry's retry trigger) counts the photometric rows only: equal to the
+// combined RMS without line rows, 0 without photometric rows, and with both families the
+// photometric rows' RMS at (nearly) the same pose as the photometric-only solve.
+TEST(TrackerTest, PhotometricRmsCountsThePhotometricRowsOnly) {
+  const FramePair& pair = Pair("lowtex");
+  const TrackingReference reference =
+      MakePairReference(pair, GroundTruthReferenceOptions(), /*with_edges=*/true);
+  const ImagePyramid current(pair.cur_image, 4);
+  auto track = [&](Mode mode) {
+    return Tracker(ModeOptions(mode, SolverOptions::Type::kGaussNewton))
+        .Track(reference, current, SE3());
+  };
+  const TrackingResult photometric = track(Mode::kPhotometric);
+  const TrackingResult lines = track(Mode::kLines);
+  const TrackingResult both = track(Mode::kBoth);
+  EXPECT_GT(photometric.final_rms, 0.0);
+  EXPECT_DOUBLE_EQ(photometric.final_photometric_rms, photometric.final_rms);
+  EXPECT_GT(lines.final_rms, 0.0);
+  EXPECT_EQ(lines.final_photometric_rms, 0.0);
+  EXPECT_NE(both.final_photometric_rms, both.final_rms);
+  EXPECT_NEAR(both.final_photometric_rms, photometric.final_rms, 0.05 * photometric.final_rms);
+}
+
 TEST(TrackerTest, CeresTrackerRecoversThePoseToo) {
   const FramePair& pair = Pair("lowtex");
   const TrackingReference reference =
