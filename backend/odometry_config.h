@@ -79,10 +79,10 @@ struct OdometryOptions {
   // prior is off by the acceleration since the last frame); 0 = off.
   double line_prior_gate_px = 2.0;
   // Alternative initial guesses (besides the constant-velocity prior) are tried when the result
-  // is lost, or when its final RMS exceeds retry_rms_ratio times the running mean of the RMS of
-  // recent good frames: zero motion since the last good frame, and that pose rotated by
-  // +-alternative_rotation_deg about the camera's x and y axes. The best non-lost result (most
-  // inlier rows at the finest level) wins.
+  // is lost, or when its final photometric RMS exceeds retry_rms_ratio times the running mean
+  // over recent tracked frames (backend/retry_trigger.h): zero motion since the last good
+  // frame, and that pose rotated by +-alternative_rotation_deg about the camera's x and y axes.
+  // The best non-lost result (most inlier rows at the finest level) wins.
   bool try_alternatives = true;
   double retry_rms_ratio = 1.5;
   double alternative_rotation_deg = 2.0;
@@ -130,7 +130,7 @@ struct OdometryOptions {
     v.Field("try_alternatives", &try_alternatives,
             "Retry lost or high-residual frames from alternative initial guesses.");
     v.Field("retry_rms_ratio", &retry_rms_ratio,
-            "Retry when the final RMS exceeds this times the recent mean RMS (default 1.5).");
+            "Retry when the final photometric RMS exceeds this times the recent mean (1.5).");
     v.Field("alternative_rotation_deg", &alternative_rotation_deg,
             "Rotation of the alternative guesses about the camera x and y axes, deg (default 2).");
     v.Field("reinit_after_lost", &reinit_after_lost,
