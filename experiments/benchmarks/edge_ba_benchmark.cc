@@ -19,12 +19,7 @@ namespace {
 
 EdgeBASimulation MakeWindow(int num_keyframes) {
   const EdgeBAScene scene = MakeRandomLineScene(150, num_keyframes, 0.3, 5);
-  PinholeCamera camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 525.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
+  const PinholeCamera camera{640, 480, 525.0, 525.0, 319.5, 239.5};
   EdgeBASimulationOptions options;
   options.provide_initial_lines = false;
   options.seed = 6;

@@ -30,11 +30,7 @@ struct Scene {
   std::vector<PointToLineObservation> lines;
 
   Scene() {
-    camera.width = 640;
-    camera.height = 480;
-    camera.fx = camera.fy = 500.0;
-    camera.cx = 319.5;
-    camera.cy = 239.5;
+    camera = PinholeCamera{640, 480, 500.0, 500.0, 319.5, 239.5};
     cv::Mat image(camera.height, camera.width, CV_32F);
     for (int y = 0; y < image.rows; ++y) {
       for (int x = 0; x < image.cols; ++x) {

@@ -20,15 +20,7 @@
 namespace pldvo {
 namespace {
 
-PinholeCamera TestCamera() {
-  PinholeCamera camera;
-  camera.width = 320;
-  camera.height = 240;
-  camera.fx = camera.fy = 250.0;
-  camera.cx = 160.0;
-  camera.cy = 120.0;
-  return camera;
-}
+PinholeCamera TestCamera() { return PinholeCamera{320, 240, 250.0, 250.0, 160.0, 120.0}; }
 
 // A positive definite tangent covariance with correlations: sigmas of 1-2 cm (origin) and
 // 0.3-0.6 deg (direction) for a line ~3 m away, small enough for the first order to hold.

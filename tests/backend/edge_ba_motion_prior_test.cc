@@ -102,12 +102,7 @@ TEST(EdgeBAMotionPriorTest, JacobiansMatchNumericDifferences) {
 }
 
 TEST(EdgeBAMotionPriorTest, BuilderAddsOnePriorPerTrackedPair) {
-  PinholeCamera camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 525.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
+  const PinholeCamera camera{640, 480, 525.0, 525.0, 319.5, 239.5};
   const EdgeBAScene scene = MakeRandomLineScene(60, 4, 0.5, 1);
   EdgeBAWindow window =
       SimulateEdgeBAWindow(camera, scene.world_from_cam, scene.start, scene.end, {}).window;

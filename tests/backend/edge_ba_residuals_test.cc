@@ -21,16 +21,7 @@
 namespace pldvo {
 namespace {
 
-PinholeCamera Camera() {
-  PinholeCamera camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = 520.0;
-  camera.fy = 510.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
-}
+PinholeCamera Camera() { return PinholeCamera{640, 480, 520.0, 510.0, 319.5, 239.5}; }
 
 SE3 CamFromWorld() {
   Vector6d twist;

@@ -50,12 +50,7 @@ EdgeBASimulation MakeRoomSimulation(int num_keyframes, std::uint64_t seed,
 EdgeBASimulation MakeRandomSimulation(int num_keyframes, std::uint64_t seed,
                                       const EdgeBASimulationOptions& base = {}) {
   const EdgeBAScene scene = MakeRandomLineScene(80, num_keyframes, 0.5, seed);
-  PinholeCamera camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 525.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
+  const PinholeCamera camera{640, 480, 525.0, 525.0, 319.5, 239.5};
   EdgeBASimulationOptions options = base;
   options.seed = seed + 1000;
   return SimulateEdgeBAWindow(camera, scene.world_from_cam, scene.start, scene.end, options);

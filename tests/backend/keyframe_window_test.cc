@@ -14,15 +14,7 @@
 namespace pldvo {
 namespace {
 
-PinholeCamera Camera() {
-  PinholeCamera camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 500.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
-}
+PinholeCamera Camera() { return PinholeCamera{640, 480, 500.0, 500.0, 319.5, 239.5}; }
 
 // Horizontal segments at rows `rows` (ids 0, 1, ...), traced from x = 10 to 49 with one pixel of
 // widening above and below (as EdgeTracer with half_width_px = 1).

@@ -17,15 +17,7 @@
 namespace pldvo {
 namespace {
 
-PinholeCamera TestCamera() {
-  PinholeCamera camera;
-  camera.width = 320;
-  camera.height = 240;
-  camera.fx = camera.fy = 260.0;
-  camera.cx = 159.5;
-  camera.cy = 119.5;
-  return camera;
-}
+PinholeCamera TestCamera() { return PinholeCamera{320, 240, 260.0, 260.0, 159.5, 119.5}; }
 
 struct EdgeCase {
   TracedLine line;

@@ -13,16 +13,7 @@
 namespace pldvo {
 namespace {
 
-PinholeCamera TestCamera() {
-  PinholeCamera camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = 500.0;
-  camera.fy = 510.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
-  return camera;
-}
+PinholeCamera TestCamera() { return PinholeCamera{640, 480, 500.0, 510.0, 319.5, 239.5}; }
 
 // The image line through the projections of two 3D points (a^2 + b^2 = 1).
 Eigen::Vector3d ProjectLine(const PinholeCamera& camera, const Eigen::Vector3d& a,

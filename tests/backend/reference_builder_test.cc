@@ -22,13 +22,7 @@ constexpr int kWidth = 96;
 constexpr int kHeight = 64;
 
 PinholeCamera Camera() {
-  PinholeCamera camera;
-  camera.width = kWidth;
-  camera.height = kHeight;
-  camera.fx = camera.fy = 80.0;
-  camera.cx = kWidth / 2.0;
-  camera.cy = kHeight / 2.0;
-  return camera;
+  return PinholeCamera{kWidth, kHeight, 80.0, 80.0, kWidth / 2.0, kHeight / 2.0};
 }
 
 // A gradient image with texture everywhere (stereo finds matches on every row).

@@ -17,15 +17,7 @@
 namespace pldvo {
 namespace {
 
-PinholeCamera TestCamera() {
-  PinholeCamera camera;
-  camera.width = 160;
-  camera.height = 120;
-  camera.fx = camera.fy = 130.0;
-  camera.cx = 79.5;
-  camera.cy = 59.5;
-  return camera;
-}
+PinholeCamera TestCamera() { return PinholeCamera{160, 120, 130.0, 130.0, 79.5, 59.5}; }
 
 TEST(SemiDenseDepthMapTest, FuseIsProductOfGaussians) {
   SemiDenseDepthMap map(4, 4);

@@ -17,14 +17,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 PinholeCamera Intrinsics(int width, int height, double fx, double fy, double cx, double cy) {
-  PinholeCamera camera;
-  camera.width = width;
-  camera.height = height;
-  camera.fx = fx;
-  camera.fy = fy;
-  camera.cx = cx;
-  camera.cy = cy;
-  return camera;
+  return PinholeCamera{width, height, fx, fy, cx, cy};
 }
 
 // TUM fr1 (radtan) and a TUM monoVO-like fov camera: the relative calibration

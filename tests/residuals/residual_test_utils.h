@@ -20,16 +20,7 @@
 namespace pldvo {
 namespace testing_utils {
 
-inline PinholeCamera TestCamera() {
-  PinholeCamera camera;
-  camera.width = 160;
-  camera.height = 120;
-  camera.fx = 140.0;
-  camera.fy = 135.0;
-  camera.cx = 79.5;
-  camera.cy = 59.5;
-  return camera;
-}
+inline PinholeCamera TestCamera() { return PinholeCamera{160, 120, 140.0, 135.0, 79.5, 59.5}; }
 
 // A smooth texture: wavelengths 29..53 px, gradients of about 10 gray levels per pixel.
 inline double SmoothIntensity(double x, double y) {
