@@ -136,14 +136,18 @@ void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
     if (status != StereoStatus::kOk) return;
     ++stats->ssd_ok;
   }
+  // Every stereo observation of the pixel (SSD or line-guided) shares part of its error with the
+  // others (options.stereo_error_correlation, SemiDenseDepthMap::Fuse).
+  const double correlation = options_.stereo_error_correlation;
   if (valid) {
-    if (map_.Fuse(index, observation.idepth, observation.idepth_var, options_)) {
+    if (map_.Fuse(index, observation.idepth, observation.idepth_var, correlation, options_)) {
       ++stats->fused;
     } else {
       ++stats->outliers;
     }
   } else {
-    map_.Set(index, observation.idepth, observation.idepth_var, options_.validity_initial);
+    map_.Set(index, observation.idepth, observation.idepth_var, options_.validity_initial,
+             std::sqrt(correlation * observation.idepth_var));
     map_.CountObservation(index);
     ++stats->created;
   }
@@ -196,7 +200,8 @@ LineDepthFusionStats DepthMapper::FuseLineDepths(const std::vector<KeyframeLine>
       ++stats.skipped;
       continue;
     }
-    if (map_.Fuse(i, idepth, idepth_var, options_)) {
+    // The edge BA's line depth is independent of the pixel's stereo observations.
+    if (map_.Fuse(i, idepth, idepth_var, 0.0, options_)) {
       ++stats.fused;
     } else {
       ++stats.outliers;

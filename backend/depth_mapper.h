@@ -14,7 +14,8 @@
 // its keyframe line l1 (the ray of a traced pixel up to 1.5 px off l1 misses the 3D line; its
 // nearest edge point is the foot point), falling back to the SSD search when the epipolar line
 // and the edge are nearly parallel; all other pixels: the SSD search over
-// idepth +- 2 sigma) and the observation is fused by the EKF (SemiDenseDepthMap::Fuse); pixels
+// idepth +- 2 sigma) and the observation is fused by the EKF with correlated observation errors
+// (SemiDenseDepthMap::Fuse, options.stereo_error_correlation); pixels
 // without a hypothesis are searched over [min_idepth, max_idepth] and initialised from the
 // observation. Then isolated hypotheses are removed and holes filled (depth_regularizer.h).
 // Smoothing and the 3D line regularisation act on a copy (RegularizedMap), never on the filter
@@ -107,6 +108,8 @@ class DepthMapper {
   const SemiDenseDepthMap& depth_map() const { return map_; }
   const ImagePyramid& keyframe() const { return keyframe_; }
   const EdgeTrace& edges() const { return edges_; }
+  // l1 of every edge id of the keyframe (a^2 + b^2 = 1; zero for ids the trace does not hold).
+  const std::vector<Eigen::Vector3d>& keyframe_lines() const { return line_in_ref_by_id_; }
   const PinholeCamera& camera() const { return camera_; }
   const MappingOptions& options() const { return options_; }
 
@@ -121,8 +124,7 @@ class DepthMapper {
   ImagePyramid keyframe_;
   EdgeTrace edges_;
   SemiDenseDepthMap map_;
-  // l1 of every edge id (a^2 + b^2 = 1); zero for ids the trace does not hold.
-  std::vector<Eigen::Vector3d> line_in_ref_by_id_;
+  std::vector<Eigen::Vector3d> line_in_ref_by_id_;  // keyframe_lines()
 };
 
 }  // namespace pldvo

@@ -31,6 +31,9 @@ std::string MappingOptions::Check() const {
   if (min_line_epipolar_angle_deg < 0.0 || min_line_epipolar_angle_deg >= 90.0) {
     error << "min_line_epipolar_angle_deg must be in [0, 90); ";
   }
+  if (!(stereo_error_correlation >= 0.0 && stereo_error_correlation < 1.0)) {
+    error << "stereo_error_correlation must be in [0, 1); ";
+  }
   if (outlier_gate_sigmas <= 0.0) error << "outlier_gate_sigmas must be > 0; ";
   if (validity_initial <= 0 || validity_increment < 0 || validity_decrement <= 0 ||
       validity_max < validity_initial) {

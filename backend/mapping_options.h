@@ -71,6 +71,13 @@ struct MappingOptions {
   bool line_stereo_refine_ssd = false;
 
   // ---- EKF fusion and outliers (Engel 2013 Sec. 2.3).
+  // rho of the correlated-error fusion (SemiDenseDepthMap::Fuse, docs/mapping.md): the fraction
+  // of a stereo observation's variance (SSD or line-guided) that is shared by all stereo
+  // observations of the pixel (the same patch and edge matched over similar baselines), so that
+  // the fused variance has the floor rho V_obs instead of shrinking as 1/n. 0 = independent
+  // errors (the EKF of Engel 2013). 0.1: the smallest shared fraction measured on six
+  // synthetic scenes (0.08-0.43; docs/mapping.md, "Correlated observation errors").
+  double stereo_error_correlation = 0.1;
   // An observation further than gate sigmas from the prior (sqrt(V + V_obs)) is an outlier.
   double outlier_gate_sigmas = 2.0;
   int validity_initial = 20;   // validity counter of a new hypothesis
@@ -109,6 +116,11 @@ struct MappingOptions {
   // ---- Tracking reference (reference_builder.h).
   // At most this many points per pyramid level, evenly spaced in raster order (0 = all).
   int max_reference_points = 4000;
+  // Point-to-line residuals (and the line gates) reproject each edge pixel's foot point on its
+  // keyframe line instead of the traced pixel, which lies up to 1.5 px off the line while its
+  // inverse depth is that of the line (ReferencePoint::pixel_on_edge; docs/odometry.md). Off by
+  // default: measured no better end to end (docs/odometry.md, "Edge foot points").
+  bool edge_foot_points = false;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
@@ -148,6 +160,9 @@ struct MappingOptions {
             "Check line-guided matches with one 5-sample SSD (default true).");
     v.Field("line_stereo_refine_ssd", &line_stereo_refine_ssd,
             "Refine line-guided matches by an SSD search within +- search_sigmas of them.");
+    v.Field("stereo_error_correlation", &stereo_error_correlation,
+            "Fraction of a stereo observation's variance shared by all observations of the pixel "
+            "(fusion floor; 0 = independent EKF; default 0.1).");
     v.Field("outlier_gate_sigmas", &outlier_gate_sigmas,
             "Observations further than this many sigmas are outliers (default 2).");
     v.Field("validity_initial", &validity_initial, "Validity counter of a new hypothesis (20).");
@@ -177,6 +192,9 @@ struct MappingOptions {
             "Drop propagated hypotheses whose intensities differ more, gray levels (25).");
     v.Field("max_reference_points", &max_reference_points,
             "Tracking reference points per pyramid level, evenly spaced (0 = all; default 4000).");
+    v.Field("edge_foot_points", &edge_foot_points,
+            "Point-to-line residuals reproject the edge pixels' foot points on their keyframe "
+            "lines instead of the traced pixels (default false).");
   }
   // "" when valid, otherwise what is wrong (names the field).
   std::string Check() const;

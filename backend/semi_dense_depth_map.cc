@@ -22,6 +22,7 @@ SemiDenseDepthMap::SemiDenseDepthMap(int width, int height) : width_(width), hei
   validity_.assign(n, 0);
   blacklist_.assign(n, 0);
   num_observations_.assign(n, 0);
+  idepth_shared_sd_.assign(n, 0.f);
 }
 
 void SemiDenseDepthMap::SelectPixels(const ImagePyramid& keyframe, const cv::Mat& edge_id_map,
@@ -40,6 +41,7 @@ void SemiDenseDepthMap::SelectPixels(const ImagePyramid& keyframe, const cv::Mat
   std::fill(validity_.begin(), validity_.end(), 0);
   std::fill(blacklist_.begin(), blacklist_.end(), 0);
   std::fill(num_observations_.begin(), num_observations_.end(), 0);
+  std::fill(idepth_shared_sd_.begin(), idepth_shared_sd_.end(), 0.f);
   const float threshold_sq =
       static_cast<float>(options.gradient_threshold * options.gradient_threshold);
   const int b = options.border_px;
@@ -88,9 +90,11 @@ void SemiDenseDepthMap::InitializeFromDepth(const cv::Mat& depth, double idepth_
   }
 }
 
-void SemiDenseDepthMap::Set(int i, double idepth, double idepth_var, int validity) {
+void SemiDenseDepthMap::Set(int i, double idepth, double idepth_var, int validity,
+                            double idepth_shared_sd) {
   idepth_[i] = static_cast<float>(idepth);
   idepth_var_[i] = static_cast<float>(idepth_var);
+  idepth_shared_sd_[i] = static_cast<float>(idepth_shared_sd);
   valid_[i] = 1;
   validity_[i] = static_cast<int16_t>(validity);
   num_observations_[i] = 0;
@@ -101,7 +105,7 @@ void SemiDenseDepthMap::SetCandidate(int i, bool candidate, int edge_id) {
   edge_id_[i] = edge_id;
 }
 
-bool SemiDenseDepthMap::Fuse(int i, double idepth_obs, double idepth_obs_var,
+bool SemiDenseDepthMap::Fuse(int i, double idepth_obs, double idepth_obs_var, double correlation,
                              const MappingOptions& options) {
   const double prior = idepth_[i], prior_var = idepth_var_[i];
   const double diff = idepth_obs - prior;
@@ -111,9 +115,29 @@ bool SemiDenseDepthMap::Fuse(int i, double idepth_obs, double idepth_obs_var,
     if (validity_[i] <= 0) valid_[i] = 0;
     return false;
   }
-  const double sum_var = prior_var + idepth_obs_var;
-  idepth_[i] = static_cast<float>((idepth_obs_var * prior + prior_var * idepth_obs) / sum_var);
-  idepth_var_[i] = static_cast<float>(prior_var * idepth_obs_var / sum_var);
+  const double prior_shared_sd = idepth_shared_sd_[i];
+  if (correlation == 0.0 && prior_shared_sd == 0.0) {
+    // Independent errors: the product of Gaussians.
+    const double sum_var = prior_var + idepth_obs_var;
+    idepth_[i] = static_cast<float>((idepth_obs_var * prior + prior_var * idepth_obs) / sum_var);
+    idepth_var_[i] = static_cast<float>(prior_var * idepth_obs_var / sum_var);
+  } else {
+    // Correlated errors (header): A, B the prior's independent variance and shared sd, beta the
+    // observation's shared sd, obs_independent_var its independent variance.
+    const double b = std::min(prior_shared_sd, std::sqrt(prior_var));
+    const double a = prior_var - b * b;
+    const double beta = std::sqrt(correlation * idepth_obs_var);
+    const double obs_independent_var = (1.0 - correlation) * idepth_obs_var;
+    const double denominator = a + obs_independent_var + (b - beta) * (b - beta);
+    const double kappa =
+        denominator > 0.0 ? std::clamp((a + b * (b - beta)) / denominator, 0.0, 1.0) : 0.5;
+    const double shared_sd = (1.0 - kappa) * b + kappa * beta;
+    idepth_[i] = static_cast<float>(prior + kappa * diff);
+    idepth_var_[i] =
+        static_cast<float>((1.0 - kappa) * (1.0 - kappa) * a + kappa * kappa * obs_independent_var +
+                           shared_sd * shared_sd);
+    idepth_shared_sd_[i] = static_cast<float>(shared_sd);
+  }
   validity_[i] = static_cast<int16_t>(
       std::min(options.validity_max, validity_[i] + options.validity_increment));
   CountObservation(i);

@@ -3,8 +3,9 @@
 // the inverse depth, mean D = idepth (1/m) and variance V = idepth_var ((1/m)^2), plus the
 // bookkeeping of the semi-dense filter: validity counter (outlier removal), blacklist counter
 // (pixels whose stereo keeps failing), the number of fused stereo observations and the id of the
-// edge the pixel lies on. Storage is flat per-pixel arrays (row-major, index y * width + x);
-// nothing is allocated per pixel.
+// edge the pixel lies on, and the part of the hypothesis' error that is shared with the pixel's
+// future stereo observations (the correlated-error fusion of Fuse). Storage is flat per-pixel
+// arrays (row-major, index y * width + x); nothing is allocated per pixel.
 #ifndef PLDVO_BACKEND_SEMI_DENSE_DEPTH_MAP_H_
 #define PLDVO_BACKEND_SEMI_DENSE_DEPTH_MAP_H_
 
@@ -52,9 +53,15 @@ class SemiDenseDepthMap {
   int validity(int i) const { return validity_[i]; }
   int blacklist(int i) const { return blacklist_[i]; }
   int num_observations(int i) const { return num_observations_[i]; }
+  // B of Fuse: the standard deviation of the hypothesis' error component that is shared with
+  // the pixel's future stereo observations, 1/m; B^2 <= V.
+  float idepth_shared_sd(int i) const { return idepth_shared_sd_[i]; }
 
-  // Sets a new hypothesis: marks it valid and resets its observation count.
-  void Set(int i, double idepth, double idepth_var, int validity);
+  // Sets a new hypothesis: marks it valid and resets its observation count. idepth_shared_sd is
+  // B of Fuse: 0 for a hypothesis whose error is independent of future stereo observations
+  // (initialisation, propagation, hole filling), sqrt(rho V) for one created from a stereo
+  // observation.
+  void Set(int i, double idepth, double idepth_var, int validity, double idepth_shared_sd = 0.0);
   // Changes the mean only (regularisation); the pixel must be valid.
   void SetIdepth(int i, double idepth) { idepth_[i] = static_cast<float>(idepth); }
   void SetIdepthAndVar(int i, double idepth, double idepth_var) {
@@ -71,12 +78,29 @@ class SemiDenseDepthMap {
   }
   void SetValidity(int i, int validity) { validity_[i] = static_cast<int16_t>(validity); }
 
-  // The EKF update of one pixel with an inverse-depth observation (a product of Gaussians):
-  //   D' = (V_obs D + V D_obs) / (V + V_obs),   V' = V V_obs / (V + V_obs).
+  // The update of one pixel with an inverse-depth observation D_obs of variance V_obs = s^2.
+  // Correlated-error model (docs/mapping.md, "Correlated observation errors"): the observation's
+  // error is beta u + w, u ~ N(0, 1) shared by every stereo observation of the pixel (the same
+  // scene patch matched over similar baselines), beta = sqrt(rho) s, w ~ N(0, (1 - rho) s^2)
+  // independent; rho = `correlation` (options.stereo_error_correlation for stereo, 0 for an
+  // independent source). The hypothesis' error is B u + (independent part of variance
+  // A = V - B^2). The fused D' = D + kappa (D_obs - D) minimises
+  //   V' = (1 - kappa)^2 A + kappa^2 (1 - rho) s^2 + ((1 - kappa) B + kappa beta)^2,
+  //   kappa = (A + B (B - beta)) / (A + (1 - rho) s^2 + (B - beta)^2),
+  //   B' = (1 - kappa) B + kappa beta.
+  // With rho = 0 (and B = 0) this is the EKF of Engel 2013, a product of Gaussians:
+  //   D' = (V_obs D + V D_obs) / (V + V_obs),   V' = V V_obs / (V + V_obs);
+  // with rho > 0, n observations of equal s into a flat prior give their mean with
+  // V = rho s^2 + (1 - rho) s^2 / n (a floor).
   // When |D_obs - D| > gate_sigmas sqrt(V + V_obs) the observation is an outlier: the validity
   // counter drops by options.validity_decrement and the hypothesis is invalidated at <= 0.
   // Otherwise the validity rises by options.validity_increment (capped). Returns true when fused.
-  bool Fuse(int i, double idepth_obs, double idepth_obs_var, const MappingOptions& options);
+  bool Fuse(int i, double idepth_obs, double idepth_obs_var, double correlation,
+            const MappingOptions& options);
+  // A stereo observation: correlation = options.stereo_error_correlation.
+  bool Fuse(int i, double idepth_obs, double idepth_obs_var, const MappingOptions& options) {
+    return Fuse(i, idepth_obs, idepth_obs_var, options.stereo_error_correlation, options);
+  }
 
   int CountCandidates() const;
   int CountValid() const;
@@ -92,6 +116,7 @@ class SemiDenseDepthMap {
   std::vector<int16_t> validity_;
   std::vector<int16_t> blacklist_;
   std::vector<uint16_t> num_observations_;
+  std::vector<float> idepth_shared_sd_;
 };
 
 }  // namespace pldvo
