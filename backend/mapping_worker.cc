@@ -142,7 +142,8 @@ void MappingWorker::ThreadLoop() {
 
 void MappingWorker::Publish(std::shared_ptr<KeyframeMap> keyframe_map) {
   keyframe_map->reference = std::make_shared<const TrackingReference>(BuildReferencePoints(
-      *keyframe_map->map, keyframe_levels_, camera_, options_.max_reference_points));
+      *keyframe_map->map, keyframe_levels_, camera_, options_.max_reference_points,
+      options_.edge_foot_points ? mapper_.keyframe_lines() : std::vector<Eigen::Vector3d>()));
   keyframe_map->mean_idepth = MeanInverseDepth(*keyframe_map->map);
   keyframe_map->num_points =
       keyframe_map->reference->levels.empty()

@@ -41,7 +41,19 @@ void ThinEvenly(int max_points, std::vector<ReferencePoint>* points) {
   points->resize(kept);
 }
 
-void AddPoints(const LevelSums& sums, const ImagePyramid& keyframe, int level,
+// The foot point of `pixel` on the level-0 line `line_at_level0` expressed at `level`; `pixel`
+// itself when the line is unknown (zero).
+Eigen::Vector2d FootPoint(const Eigen::Vector2d& pixel, const Eigen::Vector3d& line_at_level0,
+                          int level) {
+  if (!(line_at_level0.head<2>().squaredNorm() > 0.0)) return pixel;
+  LineWithCovariance line;
+  line.line = line_at_level0;
+  const Eigen::Vector3d l = LineAtLevel(line, level).line;
+  return pixel - (l.head<2>().dot(pixel) + l.z()) * l.head<2>();
+}
+
+void AddPoints(const LevelSums& sums, const ImagePyramid& keyframe,
+               const std::vector<Eigen::Vector3d>& keyframe_lines, int level,
                TrackingReferenceLevel* out) {
   const cv::Mat& image = keyframe.level(level);
   out->points.reserve(out->points.size() + sums.width * sums.height / 8);
@@ -56,6 +68,10 @@ void AddPoints(const LevelSums& sums, const ImagePyramid& keyframe, int level,
       point.idepth_var = sums.count[i] / sums.weight[i];
       point.intensity = row[3 * x];
       point.edge_id = sums.edge_id[i];
+      point.pixel_on_edge =
+          point.edge_id >= 0 && point.edge_id < static_cast<int>(keyframe_lines.size())
+              ? FootPoint(point.pixel, keyframe_lines[point.edge_id], level)
+              : point.pixel;
       out->points.push_back(point);
     }
   }
@@ -64,7 +80,8 @@ void AddPoints(const LevelSums& sums, const ImagePyramid& keyframe, int level,
 }  // namespace
 
 TrackingReference BuildReferencePoints(const SemiDenseDepthMap& map, const ImagePyramid& keyframe,
-                                       const PinholeCamera& camera, int max_points_per_level) {
+                                       const PinholeCamera& camera, int max_points_per_level,
+                                       const std::vector<Eigen::Vector3d>& keyframe_lines) {
   if (keyframe.num_levels() < 1 || map.width() != keyframe.width(0) ||
       map.height() != keyframe.height(0) || camera.width != map.width() ||
       camera.height != map.height()) {
@@ -117,7 +134,7 @@ TrackingReference BuildReferencePoints(const SemiDenseDepthMap& map, const Image
       }
       sums = std::move(coarse);
     }
-    AddPoints(sums, keyframe, level, &out);
+    AddPoints(sums, keyframe, keyframe_lines, level, &out);
     ThinEvenly(max_points_per_level, &out.points);
   }
   return reference;
@@ -172,7 +189,9 @@ int RemoveLineOutliers(const SE3& cur_from_ref, double max_median_px, TrackingRe
       continue;
     }
     Eigen::Vector2d pixel_cur;
-    if (!Reproject(level0.camera, cur_from_ref, point.pixel, point.idepth, &pixel_cur)) continue;
+    if (!Reproject(level0.camera, cur_from_ref, point.pixel_on_edge, point.idepth, &pixel_cur)) {
+      continue;
+    }
     const Eigen::Vector3d& l = level0.lines_in_cur[point.edge_id].line_in_cur.line;
     distances[point.edge_id].push_back(
         std::abs(l.x() * pixel_cur.x() + l.y() * pixel_cur.y() + l.z()));

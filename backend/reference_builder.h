@@ -37,8 +37,11 @@ namespace pldvo {
 // The points of every level (levels = keyframe.num_levels()), at most max_points_per_level each
 // (0 = all); lines_in_cur left empty. `keyframe` is the keyframe's pyramid, `camera` its level-0
 // camera; throws std::invalid_argument when the map, pyramid and camera sizes differ.
+// `keyframe_lines[e]` is the level-0 keyframe line l = (a, b, c), a^2 + b^2 = 1, of edge id e
+// (zero or missing: unknown); an edge point's pixel_on_edge is its foot point on that line.
 TrackingReference BuildReferencePoints(const SemiDenseDepthMap& map, const ImagePyramid& keyframe,
-                                       const PinholeCamera& camera, int max_points_per_level = 0);
+                                       const PinholeCamera& camera, int max_points_per_level = 0,
+                                       const std::vector<Eigen::Vector3d>& keyframe_lines = {});
 
 // Level-0 matched lines indexed by keyframe edge id (= keyframe segment index): entry
 // match.ref_index holds cur_segments[match.cur_index]; entries without a match are unmatched.

@@ -21,7 +21,9 @@ std::vector<Eigen::Vector2d> ReprojectEdgePixels(const TrackingReferenceLevel& r
   for (const ReferencePoint& point : ref.points) {
     if (point.edge_id < 0) continue;
     Eigen::Vector2d pixel_cur;
-    if (!Reproject(ref.camera, cur_from_ref, point.pixel, point.idepth, &pixel_cur)) continue;
+    if (!Reproject(ref.camera, cur_from_ref, point.pixel_on_edge, point.idepth, &pixel_cur)) {
+      continue;
+    }
     pixels.push_back(PixelAtLevel0(pixel_cur, level));
   }
   return pixels;

@@ -1,5 +1,6 @@
 #include "backend/tracking_problem_builder.h"
 
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -50,6 +51,11 @@ TrackingProblemBuilder::TrackingProblemBuilder(const ProblemBuilderOptions& opti
     : options_(options), loss_in_problem_(loss_in_problem) {
   const std::string error = options_.Check();
   if (!error.empty()) throw std::invalid_argument(Where(__LINE__) + error);
+  if (loss_in_problem_ && options_.weighting.line_error_model == LineErrorModel::kSharedPerEdge) {
+    throw std::invalid_argument(Where(__LINE__) +
+                                "line_error_model shared_per_edge mixes the rows of an edge "
+                                "before the row-wise loss; use the builder 'tracking'");
+  }
 }
 
 BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference,
@@ -107,7 +113,12 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
     }
     flush();
   }
-  if (UsesLines(weighting.policy)) {
+  const bool shared_line_error = weighting.line_error_model == LineErrorModel::kSharedPerEdge &&
+                                 (weighting.policy == WeightingPolicy::kCovariance ||
+                                  weighting.policy == WeightingPolicy::kLineOnly);
+  if (shared_line_error) {
+    AddSharedLineErrorBlocks(ref, level, pose, loss_inside, cur_from_ref, problem, &stats);
+  } else if (UsesLines(weighting.policy)) {
     std::vector<PointToLineObservation> observations;
     observations.reserve(batch);
     auto flush = [&]() {
@@ -128,11 +139,11 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
       }
       const MatchedLine& line = ref.lines_in_cur[point.edge_id];
       if (!line.matched) continue;
-      const double sqrt_info = LineSqrtInfo(weighting, camera, pose, point.pixel, point.idepth,
-                                            point.idepth_var, line.line_in_cur);
+      const double sqrt_info = LineSqrtInfo(weighting, camera, pose, point.pixel_on_edge,
+                                            point.idepth, point.idepth_var, line.line_in_cur);
       if (!(sqrt_info > 0.0)) continue;
       PointToLineObservation observation;
-      observation.pixel_in_ref = point.pixel;
+      observation.pixel_in_ref = point.pixel_on_edge;
       observation.idepth = point.idepth;
       observation.line_in_cur = line.line_in_cur.line;
       observation.sqrt_info = sqrt_info;
@@ -142,6 +153,63 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
     flush();
   }
   return stats;
+}
+
+void TrackingProblemBuilder::AddSharedLineErrorBlocks(
+    const TrackingReferenceLevel& ref, int level, const SE3& pose, const ceres::LossFunction* loss,
+    double* cur_from_ref, LeastSquaresProblem* problem, BuildStatistics* stats) const {
+  const PinholeCamera& camera = ref.camera;
+  std::vector<std::vector<int>> points_of_edge(ref.lines_in_cur.size());
+  for (int i = 0; i < static_cast<int>(ref.points.size()); ++i) {
+    const int edge = ref.points[i].edge_id;
+    if (edge < 0) continue;
+    if (edge >= static_cast<int>(ref.lines_in_cur.size())) {
+      throw std::invalid_argument(Where(__LINE__) + "edge id " + std::to_string(edge) +
+                                  " has no line entry");
+    }
+    if (ref.lines_in_cur[edge].matched) points_of_edge[edge].push_back(i);
+  }
+  const double edge_pixel_sigma = std::ldexp(options_.weighting.edge_pixel_sigma_px, -level);
+  const double edge_pixel_var = edge_pixel_sigma * edge_pixel_sigma;
+  std::vector<Eigen::Vector2d> pixels_cur;
+  std::vector<double> point_variances;
+  for (size_t edge = 0; edge < points_of_edge.size(); ++edge) {
+    const LineWithCovariance& line = ref.lines_in_cur[edge].line_in_cur;
+    std::vector<PointToLineObservation> observations;
+    pixels_cur.clear();
+    point_variances.clear();
+    for (const int i : points_of_edge[edge]) {
+      const ReferencePoint& point = ref.points[i];
+      Eigen::Vector2d pixel_cur;
+      // Rows outside the image at the linearisation point would enter the mix as 0.
+      if (!Reproject(camera, pose, point.pixel_on_edge, point.idepth, &pixel_cur) ||
+          !camera.IsInside(pixel_cur, 0.0)) {
+        continue;
+      }
+      const Eigen::Matrix3d pixel_cov = ReprojectedPixelCovariance(
+          camera, pose, point.pixel_on_edge, point.idepth, point.idepth_var);
+      pixels_cur.push_back(pixel_cur);
+      point_variances.push_back(
+          PointToLineVariance(line.line, Eigen::Matrix3d::Zero(), pixel_cur, pixel_cov) +
+          edge_pixel_var);
+      PointToLineObservation observation;
+      observation.pixel_in_ref = point.pixel_on_edge;
+      observation.idepth = point.idepth;
+      observation.line_in_cur = line.line;
+      observations.push_back(observation);
+    }
+    if (observations.empty()) continue;
+    EdgeLineWeights weights = SharedLineErrorWeights(line, pixels_cur, point_variances);
+    for (size_t j = 0; j < observations.size(); ++j) {
+      observations[j].sqrt_info = weights.sqrt_info[j];
+    }
+    stats->line_residuals += static_cast<int>(observations.size());
+    ++stats->residual_blocks;
+    problem->AddResidualBlock(
+        std::unique_ptr<ceres::CostFunction>(PointToLineResidual::Create(
+            camera, std::move(observations), loss, std::move(weights.shared))),
+        nullptr, {cur_from_ref});
+  }
 }
 
 }  // namespace pldvo

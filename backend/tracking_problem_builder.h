@@ -15,7 +15,9 @@
 // Layout: consecutive rows are grouped into blocks of `batch_size` rows sharing the pose block,
 // with the robust loss applied row-wise in square-root form inside the cost functions. With
 // `loss_in_problem` (registry name "tracking_ceres_loss") every row is its own block and the
-// robust loss is passed with it as a ceres::LossFunction instead.
+// robust loss is passed with it as a ceres::LossFunction instead. With line_error_model
+// shared_per_edge (builder "tracking" only) the point-to-line rows form one block per edge,
+// whitened against the line error its pixels share.
 #ifndef PLDVO_BACKEND_TRACKING_PROBLEM_BUILDER_H_
 #define PLDVO_BACKEND_TRACKING_PROBLEM_BUILDER_H_
 
@@ -32,6 +34,12 @@ class TrackingProblemBuilder : public ProblemBuilder {
                         double* cur_from_ref, LeastSquaresProblem* problem) const override;
 
  private:
+  // line_error_model shared_per_edge: one block per matched edge, its rows whitened against the
+  // shared line error (residuals/weighting.h SharedLineErrorWeights).
+  void AddSharedLineErrorBlocks(const TrackingReferenceLevel& ref, int level, const SE3& pose,
+                                const ceres::LossFunction* loss, double* cur_from_ref,
+                                LeastSquaresProblem* problem, BuildStatistics* stats) const;
+
   ProblemBuilderOptions options_;
   bool loss_in_problem_;
 };

@@ -237,6 +237,7 @@ int AddGroundTruthEdges(const cv::Mat& image, const cv::Mat& depth,
         point.idepth_var = options.idepth_var;
         point.intensity = pyramid.Sample(level, pixel.x(), pixel.y())[0];
         point.edge_id = edge_id;
+        point.pixel_on_edge = pixel;  // sampled on the projected edge
         out.points.push_back(point);
         if (level == 0) has_points = true;
       }

@@ -27,6 +27,12 @@ struct ReferencePoint {
   double idepth_var = 0.0;                          // (1/m)^2
   double intensity = 0.0;                           // I_ref(pixel) at the level, gray levels
   int edge_id = -1;  // index into TrackingReferenceLevel::lines_in_cur; -1: on no edge
+  // The point the point-to-line residual reprojects: with mapping.edge_foot_points the foot
+  // point of `pixel` on its edge's keyframe line at the level, otherwise (or when the line is
+  // unknown) `pixel` itself.
+  // Tracing puts edge pixels up to 1.5 px off the line, while an edge pixel's inverse depth is
+  // that of the 3D line at the foot point (line-guided stereo, 3D line regularisation).
+  Eigen::Vector2d pixel_on_edge = Eigen::Vector2d::Zero();
 };
 
 // The current-frame line matched to one reference edge, in the level's pixels.

@@ -1,5 +1,7 @@
 #include "residuals/covariance_models.h"
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -82,6 +84,16 @@ Eigen::Matrix3d ReprojectedPixelCovariance(const PinholeCamera& camera, const SE
                                            double idepth_var) {
   return ReprojectedPixelCovariance(
       ReprojectionIdepthJacobian(camera, cur_from_ref, pixel_in_ref, idepth), idepth_var);
+}
+
+Eigen::Matrix<double, 3, 2> LineCovarianceFactor(const Eigen::Matrix3d& line_cov) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(line_cov);  // ascending eigenvalues
+  Eigen::Matrix<double, 3, 2> factor;
+  for (int k = 0; k < 2; ++k) {
+    factor.col(k) =
+        eigen.eigenvectors().col(k + 1) * std::sqrt(std::max(eigen.eigenvalues()[k + 1], 0.0));
+  }
+  return factor;
 }
 
 double PointToLineVariance(const Eigen::Vector3d& line, const Eigen::Matrix3d& line_cov,

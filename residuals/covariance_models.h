@@ -63,6 +63,10 @@ struct LineWithCovariance {
 // std::invalid_argument when |p2 - p1| is below 1e-9 px or sigma_px < 0.
 LineWithCovariance FitLine(const Eigen::Vector2d& p1, const Eigen::Vector2d& p2, double sigma_px);
 
+// A 3x2 factor B of a line covariance with Sigma_l = B B^T (FitLine's Sigma_l has rank 2): the
+// two largest eigenpairs, B = [v1 sqrt(e1), v2 sqrt(e2)] (negative round-off clamped to 0).
+Eigen::Matrix<double, 3, 2> LineCovarianceFactor(const Eigen::Matrix3d& line_cov);
+
 // Sigma_x' of the reprojected pixel from the inverse-depth variance: J_d V J_d^T (2x2),
 // embedded as the top-left block of a 3x3 homogeneous covariance (third row and column zero),
 // ready for PointToLineVariance.

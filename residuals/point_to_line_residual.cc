@@ -56,8 +56,11 @@ inline bool PointToLineRow(const PinholeCamera& camera, const PointToLineObserva
 
 PointToLineResidual::PointToLineResidual(const PinholeCamera& camera,
                                          std::vector<PointToLineObservation> observations,
-                                         const ceres::LossFunction* loss)
-    : camera_(camera), observations_(std::move(observations)), loss_(loss) {
+                                         const ceres::LossFunction* loss, SharedLineError shared)
+    : camera_(camera),
+      observations_(std::move(observations)),
+      loss_(loss),
+      shared_(std::move(shared)) {
   if (observations_.empty()) ThrowInvalid(__LINE__, "empty batch");
   const std::string camera_error = camera.Check();
   if (!camera_error.empty()) ThrowInvalid(__LINE__, "camera: " + camera_error);
@@ -75,27 +78,28 @@ PointToLineResidual::PointToLineResidual(const PinholeCamera& camera,
     }
     rays_in_ref_.push_back(camera_.Unproject(o.pixel_in_ref));
   }
+  if (shared_.v.rows() != 0 && shared_.v.rows() != static_cast<int>(observations_.size())) {
+    ThrowInvalid(__LINE__, "shared line error has " + std::to_string(shared_.v.rows()) +
+                               " rows for " + std::to_string(observations_.size()) +
+                               " observations");
+  }
+  if (!shared_.v.allFinite() || !shared_.m.allFinite()) {
+    ThrowInvalid(__LINE__, "shared line error is not finite");
+  }
   valid_.assign(observations_.size(), 0);
+  tangent_.assign(observations_.size() * kPoseTangentSize, 0.0);
   set_num_residuals(static_cast<int>(observations_.size()));
   mutable_parameter_block_sizes()->push_back(kPoseAmbientSize);
 }
 
 bool PointToLineResidual::Evaluate(double const* const* parameters, double* residuals,
                                    double** jacobians) const {
-  const SE3 cur_from_ref = PoseFromParameters(parameters[0]);
-  const Eigen::Matrix3d rotation = cur_from_ref.rotation_matrix();
-  const Eigen::Vector3d& translation = cur_from_ref.translation();
   double* jacobian = (jacobians != nullptr) ? jacobians[0] : nullptr;
-  const MinusJacobianMatrix minus_jacobian =
-      jacobian != nullptr ? PoseMinusJacobian(parameters[0]) : MinusJacobianMatrix::Zero();
-  double row_tangent[kPoseTangentSize];
-  const int n = num_observations();
-  for (int i = 0; i < n; ++i) {
-    valid_[i] = PointToLineRow(camera_, observations_[i], rays_in_ref_[i], rotation, translation,
-                               loss_, residuals + i, jacobian != nullptr ? row_tangent : nullptr);
-    if (jacobian != nullptr) {
-      LiftTangentJacobian(minus_jacobian, row_tangent, 1, jacobian + i * kPoseAmbientSize);
-    }
+  EvaluateTangent(PoseFromParameters(parameters[0]), residuals,
+                  jacobian != nullptr ? tangent_.data() : nullptr, valid_.data());
+  if (jacobian != nullptr) {
+    LiftTangentJacobian(PoseMinusJacobian(parameters[0]), tangent_.data(), num_observations(),
+                        jacobian);
   }
   return true;
 }
@@ -105,11 +109,36 @@ void PointToLineResidual::EvaluateTangent(const SE3& cur_from_ref, double* resid
   const Eigen::Matrix3d rotation = cur_from_ref.rotation_matrix();
   const Eigen::Vector3d& translation = cur_from_ref.translation();
   const int n = num_observations();
+  const bool mix = shared_.v.rows() != 0;
+  // Mixed rows get the robust loss after the mix.
+  const ceres::LossFunction* row_loss = mix ? nullptr : loss_;
+  std::uint8_t* flags = valid != nullptr ? valid : valid_.data();
   for (int i = 0; i < n; ++i) {
-    const bool ok = PointToLineRow(
-        camera_, observations_[i], rays_in_ref_[i], rotation, translation, loss_, residuals + i,
+    flags[i] = PointToLineRow(
+        camera_, observations_[i], rays_in_ref_[i], rotation, translation, row_loss, residuals + i,
         jacobian_tangent != nullptr ? jacobian_tangent + i * kPoseTangentSize : nullptr);
-    if (valid != nullptr) valid[i] = ok;
+  }
+  if (!mix) return;
+  // r = e - V M V^T e and J = J_e - V M V^T J_e (invalid rows: 0 in, 0 out), then the loss.
+  using TangentRows = Eigen::Matrix<double, Eigen::Dynamic, kPoseTangentSize, Eigen::RowMajor>;
+  const Eigen::Vector2d coeffs =
+      shared_.m * (shared_.v.transpose() * Eigen::Map<const Eigen::VectorXd>(residuals, n));
+  Eigen::Matrix<double, 2, kPoseTangentSize> jacobian_coeffs =
+      Eigen::Matrix<double, 2, kPoseTangentSize>::Zero();
+  if (jacobian_tangent != nullptr) {
+    jacobian_coeffs =
+        shared_.m * (shared_.v.transpose() *
+                     Eigen::Map<const TangentRows>(jacobian_tangent, n, kPoseTangentSize));
+  }
+  for (int i = 0; i < n; ++i) {
+    double* row = jacobian_tangent != nullptr ? jacobian_tangent + i * kPoseTangentSize : nullptr;
+    if (!flags[i]) continue;  // already 0
+    double scale;
+    residuals[i] = RobustifyRow(loss_, residuals[i] - shared_.v.row(i).dot(coeffs), &scale);
+    if (row != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, 1, kPoseTangentSize>> jacobian_row(row);
+      jacobian_row = scale * (jacobian_row - shared_.v.row(i) * jacobian_coeffs);
+    }
   }
 }
 

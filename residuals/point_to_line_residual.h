@@ -14,11 +14,17 @@
 //
 // Weighting: sqrt_info_j = 1 / sqrt(Sigma_g) from PointToLineVariance (weighting.h), computed
 // by the caller at the linearisation point and held constant inside a solve.
+// Shared line error (optional, one block = one edge; weighting.h SharedLineErrorWeights): the
+// rows e_j = sqrt_info_j l^T x'_j (sqrt_info_j = (l^T Sigma_x'j l)^-1/2, the point part) are
+// whitened against the line error all of them share, Cov(g) = D + X Sigma_l X^T:
+//   r = (I + V V^T)^-1/2 e = e - V M V^T e,
+// with V (N x 2) and M (2 x 2) fixed at the linearisation point; the Jacobian rows are mixed
+// alike. Rows invalid at the evaluated pose enter the mix as 0 and come out as 0.
 // Robust loss (optional, not owned): row-wise square-root form, exactly as in
 // photometric_residual.h (residuals/robustify.h).
 // Validity: behind the camera (z <= 0) or outside the level's image [0, w - 1] x [0, h - 1]
 // -> residual 0, Jacobian row 0, valid(i) false; same rules as PhotometricResidual.
-// Evaluate() does no heap allocation.
+// Evaluate() does no heap allocation (its N x 6 tangent buffer is allocated once).
 #ifndef PLDVO_RESIDUALS_POINT_TO_LINE_RESIDUAL_H_
 #define PLDVO_RESIDUALS_POINT_TO_LINE_RESIDUAL_H_
 
@@ -34,6 +40,12 @@
 
 namespace pldvo {
 
+// (I + V V^T)^-1/2 = I - V M V^T of a shared line error; empty v: independent rows.
+struct SharedLineError {
+  Eigen::Matrix<double, Eigen::Dynamic, 2> v;  // D^-1/2 X B, N x 2
+  Eigen::Matrix2d m = Eigen::Matrix2d::Zero();
+};
+
 // One reference edge pixel with its matched current-frame line.
 struct PointToLineObservation {
   Eigen::Vector2d pixel_in_ref = Eigen::Vector2d::Zero();  // at the residual's pyramid level
@@ -45,15 +57,17 @@ struct PointToLineObservation {
 class PointToLineResidual : public ceres::CostFunction {
  public:
   // `camera` is the camera of the level the pixels and lines are expressed in. Throws
-  // std::invalid_argument on an empty batch, an invalid camera, |a^2 + b^2 - 1| > 1e-6, or a
-  // non-finite / negative idepth or sqrt_info.
+  // std::invalid_argument on an empty batch, an invalid camera, |a^2 + b^2 - 1| > 1e-6, a
+  // non-finite / negative idepth or sqrt_info, or a non-empty `shared` whose v does not have
+  // one row per observation.
   PointToLineResidual(const PinholeCamera& camera, std::vector<PointToLineObservation> observations,
-                      const ceres::LossFunction* loss = nullptr);
+                      const ceres::LossFunction* loss = nullptr, SharedLineError shared = {});
 
   static PointToLineResidual* Create(const PinholeCamera& camera,
                                      std::vector<PointToLineObservation> observations,
-                                     const ceres::LossFunction* loss = nullptr) {
-    return new PointToLineResidual(camera, std::move(observations), loss);
+                                     const ceres::LossFunction* loss = nullptr,
+                                     SharedLineError shared = {}) {
+    return new PointToLineResidual(camera, std::move(observations), loss, std::move(shared));
   }
 
   // parameters[0] = cur_from_ref (7). jacobians[0], if requested, is N x 7 row-major.
@@ -79,7 +93,9 @@ class PointToLineResidual : public ceres::CostFunction {
   const std::vector<PointToLineObservation> observations_;
   std::vector<Eigen::Vector3d> rays_in_ref_;
   const ceres::LossFunction* loss_;
+  const SharedLineError shared_;
   mutable std::vector<std::uint8_t> valid_;
+  mutable std::vector<double> tangent_;  // N x 6 tangent Jacobian (Evaluate's buffer)
 };
 
 }  // namespace pldvo

@@ -1,5 +1,7 @@
 #include "residuals/weighting.h"
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -24,14 +26,43 @@ std::string WeightingOptions::Check() const {
   if (!(fixed_ratio_lambda >= 0.0) || !std::isfinite(fixed_ratio_lambda)) {
     error << "fixed_ratio_lambda must be >= 0 and finite, got " << fixed_ratio_lambda << "; ";
   }
+  if (!(edge_pixel_sigma_px >= 0.0) || !std::isfinite(edge_pixel_sigma_px)) {
+    error << "edge_pixel_sigma_px must be >= 0 and finite, got " << edge_pixel_sigma_px << "; ";
+  }
+  if (line_error_model == LineErrorModel::kSharedPerEdge &&
+      (policy == WeightingPolicy::kUniform || policy == WeightingPolicy::kFixedRatio)) {
+    error << "line_error_model shared_per_edge needs a covariance policy (covariance, line_only); ";
+  }
   if (robust_loss != RobustLossKind::kNone && !PositiveFinite(robust_threshold)) {
     error << "robust_threshold must be positive and finite, got " << robust_threshold << "; ";
   }
   return error.str();
 }
 
-double LineSigmaAtLevel(const WeightingOptions& options, int level) {
-  return std::ldexp(options.line_sigma_px, -level);
+EdgeLineWeights SharedLineErrorWeights(const LineWithCovariance& line_in_cur,
+                                       const std::vector<Eigen::Vector2d>& pixels_cur,
+                                       const std::vector<double>& point_variances) {
+  const int n = static_cast<int>(pixels_cur.size());
+  EdgeLineWeights weights;
+  weights.sqrt_info.resize(n);
+  weights.shared.v.resize(n, 2);
+  const Eigen::Matrix<double, 3, 2> factor = LineCovarianceFactor(line_in_cur.cov);
+  for (int j = 0; j < n; ++j) {
+    weights.sqrt_info[j] = 1.0 / std::sqrt(std::max(point_variances[j], kMinPointLineVariance));
+    weights.shared.v.row(j) =
+        weights.sqrt_info[j] * (pixels_cur[j].homogeneous().transpose() * factor);
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> gram(weights.shared.v.transpose() *
+                                                            weights.shared.v);
+  Eigen::Vector2d f;
+  for (int k = 0; k < 2; ++k) {
+    const double s = std::max(gram.eigenvalues()[k], 0.0);
+    // (1 - 1/sqrt(1 + s)) / s = 1 / (sqrt(1 + s) (1 + sqrt(1 + s))), finite at s = 0.
+    const double root = std::sqrt(1.0 + s);
+    f[k] = 1.0 / (root * (1.0 + root));
+  }
+  weights.shared.m = gram.eigenvectors() * f.asDiagonal() * gram.eigenvectors().transpose();
+  return weights;
 }
 
 std::unique_ptr<ceres::LossFunction> MakeLossFunction(const WeightingOptions& options) {

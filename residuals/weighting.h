@@ -14,6 +14,8 @@
 //                       raw measurement noise").
 //   "photometric_only"  photometric as in "covariance", lines 0 (the builder adds no lines).
 //   "line_only"         lines as in "covariance", photometric 0 (the builder adds no pixels).
+// line_error_model chooses, for "covariance" and "line_only", whether an edge's pixels count
+// its line error Sigma_l independently (the paper) or once (shared_per_edge).
 #ifndef PLDVO_RESIDUALS_WEIGHTING_H_
 #define PLDVO_RESIDUALS_WEIGHTING_H_
 
@@ -22,17 +24,20 @@
 #include <Eigen/Core>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/image_pyramid.h"
 #include "core/options.h"
 #include "core/pinhole_camera.h"
 #include "core/se3.h"
 #include "residuals/covariance_models.h"
+#include "residuals/point_to_line_residual.h"
 
 namespace pldvo {
 
 enum class WeightingPolicy { kCovariance, kUniform, kFixedRatio, kPhotometricOnly, kLineOnly };
 enum class RobustLossKind { kNone, kHuber, kCauchy };
+enum class LineErrorModel { kPerPixel, kSharedPerEdge };
 
 inline const ChoiceNames<WeightingPolicy>& WeightingPolicyNames() {
   static const ChoiceNames<WeightingPolicy> names = {
@@ -41,6 +46,12 @@ inline const ChoiceNames<WeightingPolicy>& WeightingPolicyNames() {
       {"fixed_ratio", WeightingPolicy::kFixedRatio},
       {"photometric_only", WeightingPolicy::kPhotometricOnly},
       {"line_only", WeightingPolicy::kLineOnly}};
+  return names;
+}
+inline const ChoiceNames<LineErrorModel>& LineErrorModelNames() {
+  static const ChoiceNames<LineErrorModel> names = {
+      {"per_pixel", LineErrorModel::kPerPixel},
+      {"shared_per_edge", LineErrorModel::kSharedPerEdge}};
   return names;
 }
 inline const ChoiceNames<RobustLossKind>& RobustLossKindNames() {
@@ -54,11 +65,21 @@ struct WeightingOptions {
   WeightingPolicy policy = WeightingPolicy::kCovariance;
   // sigma_I: image noise per pixel, gray levels (0..255). 4 is LSD-SLAM's cameraPixelNoise.
   double sigma_intensity = 4.0;
-  // Line endpoint noise at pyramid level 0, pixels (isotropic); at level k it is
-  // line_sigma_px / 2^k, see LineSigmaAtLevel.
+  // "fixed_ratio" only: the pixel scale of a line row, sqrt_info = sqrt(lambda) / line_sigma_px.
+  // (The covariance policies take Sigma_l from the matched segment, which the line frontend
+  // fits with lines.detector.endpoint_sigma_px.)
   double line_sigma_px = 1.0;
   // lambda of "fixed_ratio": line cost weight relative to the photometric one.
   double fixed_ratio_lambda = 1.0;
+  // How Sigma_l of eq. 7 enters for the policies "covariance" and "line_only":
+  //   per_pixel        the paper: every pixel's sigma_g^2 = l^T Sigma_x' l + x'^T Sigma_l x', the
+  //                    rows independent (an edge of N pixels counts its line error N times);
+  //   shared_per_edge  the pixels of an edge share one line error: Cov(g) = D + X Sigma_l X^T
+  //                    with D = diag(l^T Sigma_x'j l), whitened exactly (SharedLineErrorWeights).
+  LineErrorModel line_error_model = LineErrorModel::kPerPixel;
+  // shared_per_edge only: the independent error of an edge pixel across its line at level 0,
+  // px (halved per level), added to each row's depth part: l^T Sigma_x' l + sigma_e^2.
+  double edge_pixel_sigma_px = 0.2;
   // Robust loss on every whitened residual row.
   RobustLossKind robust_loss = RobustLossKind::kHuber;
   // Its scale in whitened units (Ceres' `a`: Huber is quadratic for |r| <= a). 1.345 is
@@ -72,9 +93,15 @@ struct WeightingOptions {
              "uniform, fixed_ratio, photometric_only, line_only.");
     v.Field("sigma_intensity", &sigma_intensity, "Image noise sigma_I in gray levels.");
     v.Field("line_sigma_px", &line_sigma_px,
-            "Line endpoint noise in pixels at full resolution (isotropic).");
+            "fixed_ratio only: pixel scale of a line row (covariance policies take Sigma_l from "
+            "the segments, lines.detector.endpoint_sigma_px).");
     v.Field("fixed_ratio_lambda", &fixed_ratio_lambda,
             "Weight of the line cost relative to the photometric cost for policy fixed_ratio.");
+    v.Choice("line_error_model", &line_error_model, LineErrorModelNames(),
+             "How the line covariance enters (policies covariance, line_only): per_pixel (the "
+             "paper, eq. 7) or shared_per_edge (one line error for all pixels of an edge).");
+    v.Field("edge_pixel_sigma_px", &edge_pixel_sigma_px,
+            "shared_per_edge: independent error of an edge pixel across its line, px at level 0.");
     v.Choice("robust_loss", &robust_loss, RobustLossKindNames(),
              "Robust loss on each whitened residual: none, huber, cauchy.");
     v.Field("robust_threshold", &robust_threshold, "Scale of the robust loss in whitened units.");
@@ -90,8 +117,22 @@ inline bool UsesLines(WeightingPolicy policy) {
   return policy != WeightingPolicy::kPhotometricOnly;
 }
 
-// Line endpoint sigma at a pyramid level (each level halves the pixel coordinates).
-double LineSigmaAtLevel(const WeightingOptions& options, int level);
+// Whitening of the rows of one edge under LineErrorModel::kSharedPerEdge: with
+// e_j = sqrt_info_j l^T x'_j, sqrt_info_j = 1 / sqrt(max(s_j, kMinPointLineVariance)),
+// s_j = l^T Sigma_x'j l, and V = D^-1/2 X B (rows (x'_j; 1)^T B sqrt_info_j, Sigma_l = B B^T,
+// LineCovarianceFactor), r = (I + V V^T)^-1/2 e has identity covariance. With V^T V = P L P^T,
+// (I + V V^T)^-1/2 = I - V M V^T, M = P diag(f(l_k)) P^T, f(s) = (1 - 1/sqrt(1 + s)) / s
+// (f(0) = 1/2).
+struct EdgeLineWeights {
+  std::vector<double> sqrt_info;  // per row, the point part D^-1/2
+  SharedLineError shared;
+};
+// Floor of s_j, px^2: (0.01 px)^2, far below any image measurement, keeps D invertible for
+// points whose reprojection does not depend on their depth (no translation).
+constexpr double kMinPointLineVariance = 1e-4;
+EdgeLineWeights SharedLineErrorWeights(const LineWithCovariance& line_in_cur,
+                                       const std::vector<Eigen::Vector2d>& pixels_cur,
+                                       const std::vector<double>& point_variances);
 
 // The robust loss of the options, or nullptr for "none". Pass it to the cost functions (which
 // do not own it) or to ceres::Problem (which does, unless told otherwise).
@@ -110,7 +151,7 @@ double PhotometricSqrtInfo(const WeightingOptions& options, const PinholeCamera&
                            const Eigen::Vector2d& pixel_in_ref, double idepth, double idepth_var);
 
 // Point-to-line sqrt_info of one edge pixel from its covariance inputs: the matched line with
-// its covariance (FitLine at the level's pixels and LineSigmaAtLevel), the reprojected pixel
+// its covariance (the segment's Sigma_l moved to the level, LineAtLevel), the reprojected pixel
 // and its 3x3 covariance (ReprojectedPixelCovariance).
 double LineSqrtInfo(const WeightingOptions& options, const LineWithCovariance& line_in_cur,
                     const Eigen::Vector2d& pixel_cur, const Eigen::Matrix3d& pixel_cov);

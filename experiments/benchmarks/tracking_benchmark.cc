@@ -2,6 +2,7 @@
 // synthetic `lowtex` 640x480 frame pair (frames 10 -> 14, GT depth reference with GT line
 // matches), from the identity pose, per solver, residual layout and photometric interpolation:
 //   Track/<solver>/<builder>/batch:<N>[/<ceres linear solver>/threads:<T>][/bicubic]
+//   [/shared_line_error] (line_error_model shared_per_edge: one block per edge)
 // (no suffix: bilinear, the default).
 // The time includes building each level's problem (weights, cost functions) and solving it.
 // Run: build/experiments/benchmarks/tracking_benchmark [--benchmark_filter=...]
@@ -60,6 +61,7 @@ void RegisterAll() {
     SolverOptions::CeresLinearSolver linear;
     int threads;
     ImageInterpolation interpolation = ImageInterpolation::kBilinear;
+    LineErrorModel line_error_model = LineErrorModel::kPerPixel;
   };
   using LS = SolverOptions::CeresLinearSolver;
   const Variant variants[] = {
@@ -84,6 +86,10 @@ void RegisterAll() {
        ImageInterpolation::kBicubic},
       {SolverOptions::Type::kCeres, "tracking", 128, LS::kDenseNormalCholesky, 1,
        ImageInterpolation::kBicubic},
+      {SolverOptions::Type::kGaussNewton, "tracking", 128, LS::kDenseNormalCholesky, 1,
+       ImageInterpolation::kBilinear, LineErrorModel::kSharedPerEdge},
+      {SolverOptions::Type::kCeres, "tracking", 128, LS::kDenseNormalCholesky, 1,
+       ImageInterpolation::kBilinear, LineErrorModel::kSharedPerEdge},
   };
   for (const Variant& v : variants) {
     TrackingOptions options;
@@ -93,6 +99,7 @@ void RegisterAll() {
     options.problem_builder = v.builder;
     options.problem.batch_size = v.batch;
     options.problem.interpolation = v.interpolation;
+    options.problem.weighting.line_error_model = v.line_error_model;
     options.record_edge_pixels = false;
     std::string name = std::string("Track/") +
                        (v.solver == SolverOptions::Type::kCeres ? "ceres" : "gauss_newton") + "/" +
@@ -102,6 +109,7 @@ void RegisterAll() {
               "/threads:" + std::to_string(v.threads);
     }
     if (v.interpolation == ImageInterpolation::kBicubic) name += "/bicubic";
+    if (v.line_error_model == LineErrorModel::kSharedPerEdge) name += "/shared_line_error";
     benchmark::RegisterBenchmark(name.c_str(), BM_Track, options)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();

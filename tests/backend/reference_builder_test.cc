@@ -1,19 +1,24 @@
-// The tracking reference's point budget (reference_builder.h) and the mapping worker's
-// wait-instead-of-drop mode (mapping_worker.h).
+// The tracking reference's point budget and edge foot points (reference_builder.h) and the
+// mapping worker's wait-instead-of-drop mode (mapping_worker.h).
 #include "backend/reference_builder.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <opencv2/core.hpp>
 #include <set>
 #include <utility>
 
+#include "backend/depth_mapper.h"
 #include "backend/mapping_worker.h"
 #include "backend/semi_dense_depth_map.h"
 #include "core/image_pyramid.h"
 #include "core/pinhole_camera.h"
+#include "frontend/line_frontend.h"
+#include "residuals/covariance_models.h"
+#include "tests/backend/rendered_sequence.h"
 
 namespace pldvo {
 namespace {
@@ -87,6 +92,91 @@ TEST(ReferenceBuilderTest, BudgetKeepsEvenlySpacedSubsetOfEveryLevel) {
       EXPECT_LE(positions[k] - positions[k - 1], max_gap);
     }
   }
+}
+
+// A traced edge is a band of pixels up to 1.5 px off its keyframe line; the point-to-line
+// residual must reproject the foot points on the line, at every level.
+TEST(ReferenceBuilderTest, EdgePointsCarryTheirFootPointOnTheKeyframeLine) {
+  // l: 0.6 x - 0.8 y + 7 = 0 (unit normal), traced as the pixels within 1.5 px of it.
+  const Eigen::Vector3d line(0.6, -0.8, 7.0);
+  SemiDenseDepthMap map(kWidth, kHeight);
+  int off_line = 0;
+  for (int y = 0; y < kHeight; ++y) {
+    for (int x = 0; x < kWidth; ++x) {
+      const double distance = line.dot(Eigen::Vector3d(x, y, 1.0));
+      if (std::abs(distance) > 1.5) continue;
+      off_line += std::abs(distance) > 0.5;
+      map.SetCandidate(map.Index(x, y), true, 0);
+      map.Set(map.Index(x, y), 0.5, 0.01, 20);
+    }
+  }
+  ASSERT_GT(off_line, 50);
+  const ImagePyramid keyframe(Texture(), 3);
+  const TrackingReference reference = BuildReferencePoints(map, keyframe, Camera(), 0, {line});
+  const TrackingReference without_lines = BuildReferencePoints(map, keyframe, Camera());
+  for (int level = 0; level < 3; ++level) {
+    LineWithCovariance level0;
+    level0.line = line;
+    const Eigen::Vector3d l = LineAtLevel(level0, level).line;
+    const auto& points = reference.levels[level].points;
+    ASSERT_FALSE(points.empty());
+    for (size_t i = 0; i < points.size(); ++i) {
+      const ReferencePoint& point = points[i];
+      ASSERT_EQ(point.edge_id, 0);
+      EXPECT_NEAR(l.dot(point.pixel_on_edge.homogeneous()), 0.0, 1e-12) << "level " << level;
+      // The foot point: the pixel moved along the normal by its distance to the line.
+      const Eigen::Vector2d step = point.pixel - point.pixel_on_edge;
+      EXPECT_NEAR(step.norm(), std::abs(l.dot(point.pixel.homogeneous())), 1e-12);
+      if (step.norm() > 1e-6) {
+        EXPECT_NEAR(std::abs(step.normalized().dot(l.head<2>())), 1.0, 1e-9);
+      }
+      EXPECT_EQ(without_lines.levels[level].points[i].pixel_on_edge, point.pixel);
+    }
+  }
+}
+
+// On a rendered sequence with GT keyframe depth, the real frontend's traced edges and matches:
+// at the true pose, the reprojected foot points lie on the matched lines (up to the detector's
+// and the depth map's error), while the traced pixels themselves lie up to 1.5 px off them.
+TEST(ReferenceBuilderTest, FootPointsReprojectOntoTheMatchedLinesAtTheTruePose) {
+  constexpr int kFrame = 5;
+  const test::RenderedSequence rendered = test::RenderLowtexSequence(kFrame + 1);
+  const PinholeCamera& camera = rendered.sequence.camera;
+  LineFrontend frontend{LineFrontendOptions()};
+  const LineFrame keyframe = frontend.Process(rendered.images[0]);
+  const LineFrame frame = frontend.Process(rendered.images[kFrame]);
+  const std::vector<LineMatch> matches = frontend.Match(keyframe, frame);
+  const EdgeTrace edges = frontend.TraceMatched(keyframe, matches);
+  DepthMapper mapper(camera, MappingOptions());
+  mapper.InitializeKeyframeFromDepth(rendered.images[0], edges, rendered.first_depth, 1e-4);
+  TrackingReference reference = BuildReferencePoints(
+      mapper.depth_map(), ImagePyramid(rendered.images[0], 1), camera, 0, mapper.keyframe_lines());
+  SetMatchedLines(
+      MatchedLinesFromMatches(matches, frame.segments, static_cast<int>(keyframe.segments.size())),
+      &reference);
+  const SE3 cur_from_ref = rendered.sequence.ground_truth[kFrame].world_from_cam.Inverse() *
+                           rendered.sequence.ground_truth[0].world_from_cam;
+  std::vector<double> foot, traced;
+  for (const ReferencePoint& point : reference.levels[0].points) {
+    if (point.edge_id < 0 || !reference.levels[0].lines_in_cur[point.edge_id].matched) continue;
+    const Eigen::Vector3d& l = reference.levels[0].lines_in_cur[point.edge_id].line_in_cur.line;
+    Eigen::Vector2d on_edge, at_pixel;
+    if (!Reproject(camera, cur_from_ref, point.pixel_on_edge, point.idepth, &on_edge) ||
+        !Reproject(camera, cur_from_ref, point.pixel, point.idepth, &at_pixel)) {
+      continue;
+    }
+    foot.push_back(std::abs(l.dot(on_edge.homogeneous())));
+    traced.push_back(std::abs(l.dot(at_pixel.homogeneous())));
+  }
+  ASSERT_GT(foot.size(), 500u);
+  const auto median = [](std::vector<double> v) {
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  std::printf("edge pixels %zu: median |l^T x'| foot points %.3f px, traced pixels %.3f px\n",
+              foot.size(), median(foot), median(traced));
+  EXPECT_LT(median(foot), 0.25);
+  EXPECT_GT(median(traced), 0.4);
 }
 
 TEST(MappingWorkerTest, WaitingWhenBehindRunsEveryUpdate) {

@@ -195,11 +195,13 @@ SE3 SolveLevel0(const FramePair& pair, const TrackingReference& reference,
                 const std::string& builder_name, int batch_size, SolverOptions::Type type,
                 SolverSummary* summary, bool exact_jacobians = false,
                 WeightingPolicy policy = WeightingPolicy::kCovariance,
-                ImageInterpolation interpolation = ImageInterpolation::kBilinear) {
+                ImageInterpolation interpolation = ImageInterpolation::kBilinear,
+                LineErrorModel line_error_model = LineErrorModel::kPerPixel) {
   const ImagePyramid current(pair.cur_image, 4);
   ProblemBuilderOptions options;
   options.batch_size = batch_size;
   options.weighting.policy = policy;
+  options.weighting.line_error_model = line_error_model;
   options.interpolation = interpolation;
   Vector6d perturbation;
   perturbation << 0.004, -0.003, 0.002, 0.002, -0.003, 0.001;  // ~5 mm, ~0.2 deg
@@ -248,6 +250,29 @@ TEST(TrackerTest, CeresAndGaussNewtonConvergeToTheSamePoseOnTheLineProblem) {
   EXPECT_TRUE(gn_summary.converged) << gn_summary.message;
   EXPECT_LT(TranslationError(ceres_pose, gn_pose), 1e-6);
   EXPECT_LT(RotationErrorDeg(ceres_pose, gn_pose) * M_PI / 180.0, 1e-6);
+}
+
+// The same with the line error shared by an edge's pixels (one mixed block per edge): the
+// problem stays smooth, both solvers reach the same minimum, and with exact GT lines it is the
+// true pose to within the tracking bound.
+TEST(TrackerTest, CeresAndGaussNewtonAgreeWithTheSharedLineError) {
+  const FramePair& pair = Pair("lowtex");
+  const TrackingReference reference =
+      MakePairReference(pair, GroundTruthReferenceOptions(), /*with_edges=*/true);
+  for (const WeightingPolicy policy : {WeightingPolicy::kLineOnly, WeightingPolicy::kCovariance}) {
+    SolverSummary ceres_summary, gn_summary;
+    const SE3 ceres_pose =
+        SolveLevel0(pair, reference, "tracking", 128, SolverOptions::Type::kCeres, &ceres_summary,
+                    false, policy, ImageInterpolation::kBicubic, LineErrorModel::kSharedPerEdge);
+    const SE3 gn_pose = SolveLevel0(pair, reference, "tracking", 128,
+                                    SolverOptions::Type::kGaussNewton, &gn_summary, false, policy,
+                                    ImageInterpolation::kBicubic, LineErrorModel::kSharedPerEdge);
+    EXPECT_TRUE(ceres_summary.converged) << ceres_summary.message;
+    EXPECT_TRUE(gn_summary.converged) << gn_summary.message;
+    EXPECT_LT(PoseDistance(ceres_pose, gn_pose), 1e-6);
+    EXPECT_LT(TranslationError(gn_pose, pair.cur_from_ref), 1e-3);
+    EXPECT_LT(RotationErrorDeg(gn_pose, pair.cur_from_ref), 0.05);
+  }
 }
 
 // The photometric cost samples the current image bilinearly, so it is continuous but its

@@ -188,6 +188,49 @@ TEST_F(PointToLineResidualTest, InvalidRowsAreZeroAndFlagged) {
   EXPECT_NEAR(pixels[1].y(), camera_.height + 5.0, 1e-9);
 }
 
+// A shared line error (weighting.h SharedLineErrorWeights): some V (N x 2) and a symmetric M.
+SharedLineError RandomSharedLineError(int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> value(-0.4, 0.4);
+  SharedLineError shared;
+  shared.v.resize(n, 2);
+  for (int i = 0; i < n; ++i) shared.v.row(i) << value(rng), value(rng);
+  shared.m << 0.3, 0.05, 0.05, 0.2;
+  return shared;
+}
+
+// With a shared line error the rows are (I - V M V^T) e before the loss, e the independent rows;
+// the analytic Jacobian of that passes the GradientChecker (with and without the losses).
+TEST_F(PointToLineResidualTest, SharedLineErrorMixesTheRowsBeforeTheLoss) {
+  constexpr int kRows = 24;
+  const auto observations = MakeObservations(kRows, 3);
+  const SharedLineError shared = RandomSharedLineError(kRows, 4);
+  const PointToLineResidual independent(camera_, observations);
+  const PointToLineResidual mixed(camera_, observations, nullptr, shared);
+  Eigen::VectorXd e(kRows), r(kRows);
+  const double* parameters[] = {pose_};
+  ASSERT_TRUE(independent.Evaluate(parameters, e.data(), nullptr));
+  ASSERT_TRUE(mixed.Evaluate(parameters, r.data(), nullptr));
+  const Eigen::MatrixXd whitening =
+      Eigen::MatrixXd::Identity(kRows, kRows) - shared.v * shared.m * shared.v.transpose();
+  EXPECT_LT((r - whitening * e).cwiseAbs().maxCoeff(), 1e-12);
+
+  const SE3Manifold manifold;
+  const std::vector<const ceres::Manifold*> manifolds = {&manifold};
+  ceres::NumericDiffOptions options;
+  options.ridders_relative_initial_step_size = 1e-5;
+  for (const Loss loss_kind : {Loss::kNone, Loss::kHuber, Loss::kCauchy}) {
+    const auto loss = MakeLoss(loss_kind);
+    const PointToLineResidual cost(camera_, observations, loss.get(), shared);
+    const ceres::GradientChecker checker(&cost, &manifolds, options);
+    ceres::GradientChecker::ProbeResults results;
+    EXPECT_TRUE(checker.Probe(parameters, 1e-6, &results)) << results.error_log;
+  }
+  EXPECT_THROW(
+      PointToLineResidual(camera_, observations, nullptr, RandomSharedLineError(kRows - 1, 4)),
+      std::invalid_argument);
+}
+
 TEST_F(PointToLineResidualTest, RejectsBadInput) {
   PointToLineObservation good;
   good.pixel_in_ref = Eigen::Vector2d(50, 50);

@@ -2,9 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
 #include <cmath>
+#include <cstdio>
+#include <random>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "tests/residuals/residual_test_utils.h"
 
@@ -34,7 +38,8 @@ TEST(WeightingOptions, FieldsAndDefaults) {
   options.VisitFields(collector);
   EXPECT_EQ(collector.names,
             (std::set<std::string>{"policy", "sigma_intensity", "line_sigma_px",
-                                   "fixed_ratio_lambda", "robust_loss", "robust_threshold"}));
+                                   "fixed_ratio_lambda", "line_error_model", "edge_pixel_sigma_px",
+                                   "robust_loss", "robust_threshold"}));
   EXPECT_EQ(options.Check(), "");
   EXPECT_EQ(options.policy, WeightingPolicy::kCovariance);
   EXPECT_EQ(WeightingPolicyNames().size(), 5u);
@@ -43,6 +48,12 @@ TEST(WeightingOptions, FieldsAndDefaults) {
   const std::string error = options.Check();
   EXPECT_NE(error.find("sigma_intensity"), std::string::npos);
   EXPECT_NE(error.find("fixed_ratio_lambda"), std::string::npos);
+  EXPECT_EQ(options.line_error_model, LineErrorModel::kPerPixel);
+  WeightingOptions shared;
+  shared.line_error_model = LineErrorModel::kSharedPerEdge;
+  EXPECT_EQ(shared.Check(), "");
+  shared.policy = WeightingPolicy::kUniform;
+  EXPECT_NE(shared.Check().find("line_error_model"), std::string::npos);
 }
 
 TEST(WeightingOptions, LossFunctions) {
@@ -57,7 +68,6 @@ TEST(WeightingOptions, LossFunctions) {
   options.robust_loss = RobustLossKind::kCauchy;
   MakeLossFunction(options)->Evaluate(9.0, rho);
   EXPECT_NEAR(rho[0], 4.0 * std::log1p(9.0 / 4.0), 1e-12);
-  EXPECT_DOUBLE_EQ(LineSigmaAtLevel(options, 2), 0.25);
 }
 
 TEST(Weighting, PoliciesFromCovarianceInputs) {
@@ -120,6 +130,70 @@ TEST(Weighting, GeometryConvenienceMatchesComposition) {
   EXPECT_EQ(PhotometricSqrtInfo(options, camera, pyramid, 0, cur_from_ref,
                                 Eigen::Vector2d(-200.0, 50.0), kIdepth, kIdepthVar),
             0.0);
+}
+
+// Monte Carlo of one edge: N pixels x_j on a segment, the detected line fitted to endpoints with
+// N(0, sigma^2 I) noise (FitLine, shared by every pixel) and an independent point error of
+// variance s_j per pixel, g_j = l'^T x_j + sqrt(s_j) z_j. SharedLineErrorWeights must whiten g
+// to identity covariance; the per-pixel model (eq. 7: each row alone, 1 / sqrt(s_j + x^T Sigma_l
+// x)) gets each row's variance right but leaves the rows strongly correlated, so it counts the
+// one line error once per pixel.
+TEST(Weighting, SharedLineErrorWhitensTheRowsOfAnEdge) {
+  constexpr int kPixels = 40;
+  constexpr int kSamples = 20000;
+  constexpr double kSigma = 1.0;
+  const Eigen::Vector2d p1(80.0, 200.0), p2(380.0, 260.0);
+  const LineWithCovariance nominal = FitLine(p1, p2, kSigma);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> point_var(0.02, 0.3);
+  std::vector<Eigen::Vector2d> pixels(kPixels);
+  std::vector<double> variances(kPixels);
+  for (int j = 0; j < kPixels; ++j) {
+    pixels[j] = p1 + (j + 0.5) / kPixels * (p2 - p1);  // on the line
+    variances[j] = point_var(rng);
+  }
+  const EdgeLineWeights weights = SharedLineErrorWeights(nominal, pixels, variances);
+  const Eigen::MatrixXd whitening =
+      (Eigen::MatrixXd::Identity(kPixels, kPixels) -
+       weights.shared.v * weights.shared.m * weights.shared.v.transpose()) *
+      Eigen::Map<const Eigen::VectorXd>(weights.sqrt_info.data(), kPixels).asDiagonal();
+  Eigen::VectorXd per_pixel(kPixels);
+  for (int j = 0; j < kPixels; ++j) {
+    per_pixel[j] = 1.0 / std::sqrt(variances[j] + pixels[j].homogeneous().dot(
+                                                      nominal.cov * pixels[j].homogeneous()));
+  }
+
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd shared_cov = Eigen::MatrixXd::Zero(kPixels, kPixels);
+  Eigen::MatrixXd per_pixel_cov = Eigen::MatrixXd::Zero(kPixels, kPixels);
+  Eigen::VectorXd g(kPixels);
+  for (int k = 0; k < kSamples; ++k) {
+    const Eigen::Vector2d q1 = p1 + kSigma * Eigen::Vector2d(normal(rng), normal(rng));
+    const Eigen::Vector2d q2 = p2 + kSigma * Eigen::Vector2d(normal(rng), normal(rng));
+    const Eigen::Vector3d detected = FitLine(q1, q2, kSigma).line;
+    // FitLine's sign convention follows the endpoint order, which the noise does not flip here.
+    for (int j = 0; j < kPixels; ++j) {
+      g[j] = detected.dot(pixels[j].homogeneous()) + std::sqrt(variances[j]) * normal(rng);
+    }
+    const Eigen::VectorXd w = whitening * g;
+    const Eigen::VectorXd u = per_pixel.cwiseProduct(g);
+    shared_cov += w * w.transpose() / kSamples;
+    per_pixel_cov += u * u.transpose() / kSamples;
+  }
+  // Each entry of a 20000-sample covariance has a standard error of ~0.007 (0.01 on the
+  // diagonal); 0.05 is > 5 of them.
+  EXPECT_LT((shared_cov - Eigen::MatrixXd::Identity(kPixels, kPixels)).cwiseAbs().maxCoeff(), 0.05);
+  // Per pixel: each row alone has variance 1 (eq. 7 is right row by row) ...
+  EXPECT_LT((per_pixel_cov.diagonal().array() - 1.0).abs().maxCoeff(), 0.05);
+  // ... but neighbouring rows share the line error: correlations far from 0.
+  double mean_correlation = 0.0;
+  for (int i = 0; i < kPixels; ++i) {
+    for (int j = 0; j < kPixels; ++j) {
+      if (i != j) mean_correlation += per_pixel_cov(i, j) / (kPixels * (kPixels - 1));
+    }
+  }
+  EXPECT_GT(mean_correlation, 0.3);
+  std::printf("per-pixel model: mean row correlation %.3f\n", mean_correlation);
 }
 
 }  // namespace
