@@ -100,6 +100,25 @@ class PointToLineResidualTest : public ::testing::Test {
     return observations;
   }
 
+  // GradientChecker with the SE3Manifold, no loss, Huber and Cauchy, Ridders from a 1e-5
+  // relative step. The residual is a smooth double-precision function, so Ridders is accurate to
+  // ~1e-9; tolerance 1e-6 (the per-entry relative test also meets entries that nearly cancel).
+  void ExpectGradientCheckerPasses(const std::vector<PointToLineObservation>& observations,
+                                   const SharedLineError& shared) const {
+    const SE3Manifold manifold;
+    const std::vector<const ceres::Manifold*> manifolds = {&manifold};
+    ceres::NumericDiffOptions options;
+    options.ridders_relative_initial_step_size = 1e-5;
+    for (const Loss loss_kind : {Loss::kNone, Loss::kHuber, Loss::kCauchy}) {
+      const auto loss = MakeLoss(loss_kind);
+      const PointToLineResidual cost(camera_, observations, loss.get(), shared);
+      const ceres::GradientChecker checker(&cost, &manifolds, options);
+      ceres::GradientChecker::ProbeResults results;
+      const double* parameters[] = {pose_};
+      EXPECT_TRUE(checker.Probe(parameters, 1e-6, &results)) << results.error_log;
+    }
+  }
+
   PinholeCamera camera_;
   SE3 cur_from_ref_;
   double pose_[7];
@@ -123,22 +142,8 @@ TEST_F(PointToLineResidualTest, AnalyticMatchesAutoDiff) {
   }
 }
 
-// GradientChecker with the SE3Manifold, Ridders from a 1e-5 relative step. The residual is a
-// smooth double-precision function, so Ridders is accurate to ~1e-9; tolerance 1e-6 (the
-// per-entry relative test also meets entries that nearly cancel).
 TEST_F(PointToLineResidualTest, GradientChecker) {
-  const SE3Manifold manifold;
-  const std::vector<const ceres::Manifold*> manifolds = {&manifold};
-  ceres::NumericDiffOptions options;
-  options.ridders_relative_initial_step_size = 1e-5;
-  for (const Loss loss_kind : {Loss::kNone, Loss::kHuber, Loss::kCauchy}) {
-    const auto loss = MakeLoss(loss_kind);
-    const PointToLineResidual cost(camera_, MakeObservations(30, 2), loss.get());
-    const ceres::GradientChecker checker(&cost, &manifolds, options);
-    ceres::GradientChecker::ProbeResults results;
-    const double* parameters[] = {pose_};
-    EXPECT_TRUE(checker.Probe(parameters, 1e-6, &results)) << results.error_log;
-  }
+  ExpectGradientCheckerPasses(MakeObservations(30, 2), SharedLineError());
 }
 
 // The residual is the signed pixel distance to the line, times sqrt_info.
@@ -215,17 +220,7 @@ TEST_F(PointToLineResidualTest, SharedLineErrorMixesTheRowsBeforeTheLoss) {
       Eigen::MatrixXd::Identity(kRows, kRows) - shared.v * shared.m * shared.v.transpose();
   EXPECT_LT((r - whitening * e).cwiseAbs().maxCoeff(), 1e-12);
 
-  const SE3Manifold manifold;
-  const std::vector<const ceres::Manifold*> manifolds = {&manifold};
-  ceres::NumericDiffOptions options;
-  options.ridders_relative_initial_step_size = 1e-5;
-  for (const Loss loss_kind : {Loss::kNone, Loss::kHuber, Loss::kCauchy}) {
-    const auto loss = MakeLoss(loss_kind);
-    const PointToLineResidual cost(camera_, observations, loss.get(), shared);
-    const ceres::GradientChecker checker(&cost, &manifolds, options);
-    ceres::GradientChecker::ProbeResults results;
-    EXPECT_TRUE(checker.Probe(parameters, 1e-6, &results)) << results.error_log;
-  }
+  ExpectGradientCheckerPasses(observations, shared);
   EXPECT_THROW(
       PointToLineResidual(camera_, observations, nullptr, RandomSharedLineError(kRows - 1, 4)),
       std::invalid_argument);
