@@ -119,7 +119,8 @@ inline bool UsesLines(WeightingPolicy policy) {
 
 // Whitening of the rows of one edge under LineErrorModel::kSharedPerEdge: with
 // e_j = sqrt_info_j l^T x'_j, sqrt_info_j = 1 / sqrt(max(s_j, kMinPointLineVariance)),
-// s_j = l^T Sigma_x'j l, and V = D^-1/2 X B (rows (x'_j; 1)^T B sqrt_info_j, Sigma_l = B B^T,
+// s_j = point_variances[j] (the builder passes l^T Sigma_x'j l + edge_pixel_sigma^2), and
+// V = D^-1/2 X B (rows (x'_j; 1)^T B sqrt_info_j, Sigma_l = B B^T,
 // LineCovarianceFactor), r = (I + V V^T)^-1/2 e has identity covariance. With V^T V = P L P^T,
 // (I + V V^T)^-1/2 = I - V M V^T, M = P diag(f(l_k)) P^T, f(s) = (1 - 1/sqrt(1 + s)) / s
 // (f(0) = 1/2).
