@@ -15,6 +15,19 @@ namespace {
 
 std::string Where(int line) { return std::string(__FILE__) + ":" + std::to_string(line) + ": "; }
 
+// The current line matched to the point's edge; nullptr when the point is on no edge or its
+// edge has no match. Throws when the edge id has no entry in the level's lines.
+const MatchedLine* MatchedLineOf(const TrackingReferenceLevel& ref, const ReferencePoint& point,
+                                 int level) {
+  if (point.edge_id < 0) return nullptr;
+  if (point.edge_id >= static_cast<int>(ref.lines_in_cur.size())) {
+    throw std::invalid_argument(Where(__LINE__) + "edge id " + std::to_string(point.edge_id) +
+                                " has no line entry at level " + std::to_string(level));
+  }
+  const MatchedLine& line = ref.lines_in_cur[point.edge_id];
+  return line.matched ? &line : nullptr;
+}
+
 }  // namespace
 
 std::string ProblemBuilderOptions::Check() const {
@@ -132,20 +145,15 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
       observations.reserve(batch);
     };
     for (const ReferencePoint& point : ref.points) {
-      if (point.edge_id < 0) continue;
-      if (point.edge_id >= static_cast<int>(ref.lines_in_cur.size())) {
-        throw std::invalid_argument(Where(__LINE__) + "edge id " + std::to_string(point.edge_id) +
-                                    " has no line entry at level " + std::to_string(level));
-      }
-      const MatchedLine& line = ref.lines_in_cur[point.edge_id];
-      if (!line.matched) continue;
+      const MatchedLine* line = MatchedLineOf(ref, point, level);
+      if (line == nullptr) continue;
       const double sqrt_info = LineSqrtInfo(weighting, camera, pose, point.pixel_on_edge,
-                                            point.idepth, point.idepth_var, line.line_in_cur);
+                                            point.idepth, point.idepth_var, line->line_in_cur);
       if (!(sqrt_info > 0.0)) continue;
       PointToLineObservation observation;
       observation.pixel_in_ref = point.pixel_on_edge;
       observation.idepth = point.idepth;
-      observation.line_in_cur = line.line_in_cur.line;
+      observation.line_in_cur = line->line_in_cur.line;
       observation.sqrt_info = sqrt_info;
       observations.push_back(observation);
       if (observations.size() == batch) flush();
@@ -161,13 +169,9 @@ void TrackingProblemBuilder::AddSharedLineErrorBlocks(
   const PinholeCamera& camera = ref.camera;
   std::vector<std::vector<int>> points_of_edge(ref.lines_in_cur.size());
   for (int i = 0; i < static_cast<int>(ref.points.size()); ++i) {
-    const int edge = ref.points[i].edge_id;
-    if (edge < 0) continue;
-    if (edge >= static_cast<int>(ref.lines_in_cur.size())) {
-      throw std::invalid_argument(Where(__LINE__) + "edge id " + std::to_string(edge) +
-                                  " has no line entry");
+    if (MatchedLineOf(ref, ref.points[i], level) != nullptr) {
+      points_of_edge[ref.points[i].edge_id].push_back(i);
     }
-    if (ref.lines_in_cur[edge].matched) points_of_edge[edge].push_back(i);
   }
   const double edge_pixel_sigma = std::ldexp(options_.weighting.edge_pixel_sigma_px, -level);
   const double edge_pixel_var = edge_pixel_sigma * edge_pixel_sigma;
