@@ -67,6 +67,8 @@ const char* StereoStatusName(StereoStatus status) {
       return "bad_geometry";
     case StereoStatus::kSearchTooLong:
       return "search_too_long";
+    case StereoStatus::kTruncated:
+      return "truncated";
     case StereoStatus::kNotUnique:
       return "not_unique";
     case StereoStatus::kLargeError:
@@ -187,7 +189,8 @@ StereoStatus SearchEpipolarSsd(const ImagePyramid& current, const EpipolarGeomet
   int best = -1;
   for (int k = 0; k < num_steps; ++k) {
     ssd[k] = PatchSsd(current, patch, start + k * direction);
-    if (ssd[k] < kInf && (best < 0 || ssd[k] < ssd[best])) best = k;
+    if (!(ssd[k] < kInf)) return StereoStatus::kTruncated;
+    if (best < 0 || ssd[k] < ssd[best]) best = k;
   }
   if (best < 0) return StereoStatus::kOutside;
   double second = kInf;
@@ -198,7 +201,7 @@ StereoStatus SearchEpipolarSsd(const ImagePyramid& current, const EpipolarGeomet
   if (second < options.ssd_uniqueness_ratio * ssd[best]) return StereoStatus::kNotUnique;
   // Sub-pixel: vertex of the parabola through the neighbouring SSDs.
   double offset = 0.0;
-  if (best > 0 && best + 1 < num_steps && ssd[best - 1] < kInf && ssd[best + 1] < kInf) {
+  if (best > 0 && best + 1 < num_steps) {
     const double curvature = ssd[best - 1] - 2.0 * ssd[best] + ssd[best + 1];
     if (curvature > 1e-12) {
       offset = std::clamp(0.5 * (ssd[best - 1] - ssd[best + 1]) / curvature, -0.5, 0.5);
@@ -211,15 +214,22 @@ StereoStatus SearchEpipolarSsd(const ImagePyramid& current, const EpipolarGeomet
   if (!geometry.Project(pixel_in_ref, idepth, &check)) return StereoStatus::kOutside;
   const double jacobian_sq = geometry.IdepthJacobian(pixel_in_ref, idepth).squaredNorm();
   if (!(jacobian_sq > 1e-12)) return StereoStatus::kBadGeometry;
-  const double disparity_var =
-      GeometricDisparityVar(patch, options.sigma_epipolar_px) +
-      PhotometricDisparityVar(current, patch, match, options.sigma_intensity);
+  // The photometric disparity error with sigma_I^2 raised, if options.residual_intensity_noise,
+  // to this match's residual variance SSD / (2 (5 - 1)) (two noisy images, five samples, one
+  // fitted position): a match the noise model does not explain gets a wider variance.
+  const double residual_ssd = PatchSsd(current, patch, match);
+  const double sigma_intensity =
+      options.residual_intensity_noise
+          ? std::max(options.sigma_intensity, std::sqrt(residual_ssd / 8.0))
+          : options.sigma_intensity;
+  const double disparity_var = GeometricDisparityVar(patch, options.sigma_epipolar_px) +
+                               PhotometricDisparityVar(current, patch, match, sigma_intensity);
   if (!std::isfinite(disparity_var)) return StereoStatus::kOutside;
   observation->idepth = idepth;
   observation->disparity_var = disparity_var;
   observation->idepth_var = disparity_var / jacobian_sq;  // alpha^2 sigma_lambda^2
   observation->pixel_in_cur = match;
-  observation->ssd = ssd[best];
+  observation->ssd = residual_ssd;
   return StereoStatus::kOk;
 }
 

@@ -3,10 +3,12 @@
 // five equidistant samples along the epipolar line, restricted to the prior interval
 // idepth +- 2 sigma, with the observation variance of the geometric and photometric disparity
 // errors converted to inverse depth:
-//   sigma_lambda(xi, pi)^2 = sigma_l^2 / <g, l>^2                 (g, l unit gradient, epipolar
-//   dir) sigma_lambda(I)^2      = 2 sigma_I^2 / g_p^2                   (g_p gradient along the
-//   line) sigma_d^2              = alpha^2 (sigma_lambda(xi, pi)^2 + sigma_lambda(I)^2), alpha = d
-//   idepth / d lambda = 1 / |d tau / d idepth|.
+//   sigma_lambda(xi, pi)^2 = sigma_l^2 / <g, l>^2   (g, l: unit gradient, epipolar direction)
+//   sigma_lambda(I)^2 = 2 sigma_I^2 / g_p^2         (g_p: gradient along the line)
+//   sigma_d^2 = alpha^2 (sigma_lambda(xi, pi)^2 + sigma_lambda(I)^2),
+//   alpha = d idepth / d lambda = 1 / |d tau / d idepth|;
+// sigma_I^2 is raised to the match's residual variance SSD / 8 when that is larger
+// (options.residual_intensity_noise).
 // Geometry: a keyframe pixel x with inverse depth d appears in the current frame at
 // tau(x, d) = pi(A + d B), A = K R K^-1 (x; 1), B = K t, (R, t) = cur_from_ref; d = 0 is the
 // point at infinity, d -> infinity the epipole. See docs/mapping.md.
@@ -62,6 +64,8 @@ enum class StereoStatus {
   kOutside,             // samples or the match leave an image, or the point is behind a camera
   kBadGeometry,         // gradient orthogonal to the epipolar line, scale change, no baseline
   kSearchTooLong,       // the prior interval spans more than max_search_length_px
+  kTruncated,           // part of the prior interval leaves the current image (the true match
+                        // may lie there; the best sampled step is no evidence)
   kNotUnique,           // second-best SSD too close to the best (counts towards the blacklist)
   kLargeError,          // best SSD above max_ssd_rms (counts towards the blacklist)
   kLineIllConditioned,  // line-guided: epipolar line and edge nearly parallel
@@ -102,7 +106,11 @@ struct StereoObservation {
 };
 
 // The exhaustive SSD search along x's epipolar line over [idepth_min, idepth_max] (1-px steps,
-// parabola sub-pixel refinement), with the variance above.
+// parabola sub-pixel refinement), with the variance above. Every step of the interval must be
+// sampled: when part of it leaves the current image the search returns kTruncated, because the
+// best of the remaining steps is then a wrong match whenever the true one lies outside (under
+// forward motion the bottom rows' matches leave the image first; docs/mapping.md, "Truncated
+// searches").
 StereoStatus SearchEpipolarSsd(const ImagePyramid& current, const EpipolarGeometry& geometry,
                                const EpipolarPatch& patch, const Eigen::Vector2d& pixel_in_ref,
                                double idepth_min, double idepth_max, const MappingOptions& options,

@@ -34,6 +34,9 @@ struct MappingOptions {
   // Image noise sigma_I in gray levels: sensor noise plus bilinear-interpolation error; enters
   // the photometric disparity variance 2 sigma_I^2 / g_p^2.
   double sigma_intensity = 2.0;
+  // Raise sigma_I^2 of an SSD match to its residual variance, max(sigma_I^2, SSD / 8), SSD at
+  // the sub-pixel match (docs/mapping.md, "Residual-scaled photometric noise").
+  bool residual_intensity_noise = true;
   // sigma_l of Engel 2013: standard deviation in pixels of the epipolar line's position (pose and
   // calibration error); enters the geometric disparity variance sigma_l^2 / <g, l>^2 and the
   // line-guided variance (sigma_g of the paper).
@@ -137,6 +140,8 @@ struct MappingOptions {
     v.Field("init_seed", &init_seed, "Seed of the random initialisation (default 1).");
     v.Field("sigma_intensity", &sigma_intensity,
             "Image noise sigma_I incl. interpolation, gray levels (default 2).");
+    v.Field("residual_intensity_noise", &residual_intensity_noise,
+            "Raise sigma_I^2 of an SSD match to its residual SSD / 8 (default true).");
     v.Field("sigma_epipolar_px", &sigma_epipolar_px,
             "Epipolar line position sigma (pose error), pixels (default 0.5).");
     v.Field("search_sigmas", &search_sigmas, "Search idepth +- this many sigmas (default 2).");

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -20,6 +21,39 @@ namespace pldvo {
 namespace {
 
 PinholeCamera TestCamera() { return PinholeCamera{160, 120, 130.0, 130.0, 79.5, 59.5}; }
+
+// A fronto-parallel plane of blurred random texture at plane_depth seen from the origin (ref) and
+// from +0.1 m in x (cur: the reference shifted left by fx * 0.1 / plane_depth px), each image with
+// independent Gaussian noise of noise_sigma gray levels (CV_32F).
+struct PlanePair {
+  cv::Mat ref, cur;
+  SE3 cur_from_ref;
+  double shift_px;
+};
+
+PlanePair MakePlanePair(const PinholeCamera& camera, double plane_depth, uint64_t seed,
+                        double noise_sigma) {
+  cv::Mat texture(camera.height + 60, camera.width + 60, CV_8U);
+  cv::RNG rng(seed);
+  rng.fill(texture, cv::RNG::UNIFORM, 0, 255);
+  cv::GaussianBlur(texture, texture, cv::Size(5, 5), 1.2);
+  texture.convertTo(texture, CV_32F);
+  PlanePair pair;
+  pair.shift_px = camera.fx * 0.1 / plane_depth;
+  pair.cur_from_ref = SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(-0.1, 0.0, 0.0));
+  pair.ref = texture(cv::Rect(20, 20, camera.width, camera.height)).clone();
+  const cv::Mat warp = (cv::Mat_<double>(2, 3) << 1, 0, 20 + pair.shift_px, 0, 1, 20);
+  cv::warpAffine(texture, pair.cur, warp, cv::Size(camera.width, camera.height),
+                 cv::INTER_LINEAR | cv::WARP_INVERSE_MAP);
+  if (noise_sigma > 0.0) {
+    cv::Mat noise(pair.ref.size(), CV_32F);
+    rng.fill(noise, cv::RNG::NORMAL, 0.0, noise_sigma);
+    pair.ref += noise;
+    rng.fill(noise, cv::RNG::NORMAL, 0.0, noise_sigma);
+    pair.cur += noise;
+  }
+  return pair;
+}
 
 TEST(SemiDenseDepthMapTest, FuseIsProductOfGaussians) {
   SemiDenseDepthMap map(4, 4);
@@ -160,21 +194,9 @@ TEST(EpipolarGeometryTest, ProjectionJacobianAndInverse) {
 // from a wide prior finds the true inverse depth within 3 sigma of its own variance.
 TEST(EpipolarStereoTest, SsdSearchFindsPlaneDepth) {
   const PinholeCamera camera = TestCamera();
-  cv::Mat texture(camera.height + 60, camera.width + 60, CV_8U);
-  cv::RNG rng(7);
-  rng.fill(texture, cv::RNG::UNIFORM, 0, 255);
-  cv::GaussianBlur(texture, texture, cv::Size(5, 5), 1.2);
-  // Plane at z = 2: the current image (baseline +0.1 m in x) is the reference shifted by
-  // fx * 0.1 / 2 = 6.5 px to the left.
-  const double shift = camera.fx * 0.1 / 2.0;
-  cv::Mat ref_image = texture(cv::Rect(20, 20, camera.width, camera.height)).clone();
-  cv::Mat cur_image;
-  const cv::Mat warp = (cv::Mat_<double>(2, 3) << 1, 0, 20 + shift, 0, 1, 20);
-  cv::warpAffine(texture, cur_image, warp, cv::Size(camera.width, camera.height),
-                 cv::INTER_LINEAR | cv::WARP_INVERSE_MAP);
-  const ImagePyramid ref(ref_image, 1), cur(cur_image, 1);
-  const SE3 cur_from_ref(Eigen::Matrix3d::Identity(), Eigen::Vector3d(-0.1, 0.0, 0.0));
-  const EpipolarGeometry geometry(camera, cur_from_ref);
+  const PlanePair pair = MakePlanePair(camera, 2.0, 7, 0.0);
+  const ImagePyramid ref(pair.ref, 1), cur(pair.cur, 1);
+  const EpipolarGeometry geometry(camera, pair.cur_from_ref);
   MappingOptions options;
   int found = 0, consistent = 0;
   for (int y = 20; y < 100; y += 7) {
@@ -197,6 +219,75 @@ TEST(EpipolarStereoTest, SsdSearchFindsPlaneDepth) {
   EXPECT_GT(found, 60);
   // Random texture: a few ambiguous matches may remain; 90% must be within 3 sigma.
   EXPECT_GT(consistent, 0.9 * found);
+}
+
+// A search whose interval partly leaves the current image cannot tell a match: the true one of
+// this pixel (plane at 1 m, 13 px disparity) lies left of the image, and an exact copy of its
+// patch is pasted inside the interval at 5 px. The truncated search must not report the copy.
+TEST(EpipolarStereoTest, SsdSearchRejectsAnIntervalThatLeavesTheImage) {
+  const PinholeCamera camera = TestCamera();
+  PlanePair pair = MakePlanePair(camera, 1.0, 11, 0.0);
+  const double shift = pair.shift_px;  // 13 px
+  const int x = 10, y = 60, decoy_disparity = 5;
+  pair.ref(cv::Rect(x - 3, y - 2, 7, 5))
+      .copyTo(pair.cur(cv::Rect(x - decoy_disparity - 3, y - 2, 7, 5)));
+  const ImagePyramid ref(pair.ref, 1), cur(pair.cur, 1);
+  const EpipolarGeometry geometry(camera, pair.cur_from_ref);
+  const MappingOptions options;
+  const Eigen::Vector2d pixel(x, y);
+  EpipolarPatch patch;
+  ASSERT_EQ(MakeEpipolarPatch(ref, geometry, pixel, 0.5, options, &patch), StereoStatus::kOk);
+  StereoObservation observation;
+  // Interval [0, 2] 1/m: 0 to 26 px of disparity, the true match at 13 px is outside.
+  EXPECT_EQ(SearchEpipolarSsd(cur, geometry, patch, pixel, 0.0, 2.0, options, &observation),
+            StereoStatus::kTruncated);
+  // The same decoy inside a fully sampled interval [0, 0.5] (0 to 6.5 px) is found: the rule,
+  // not the texture, rejects the truncated search.
+  ASSERT_EQ(SearchEpipolarSsd(cur, geometry, patch, pixel, 0.0, 0.5, options, &observation),
+            StereoStatus::kOk);
+  EXPECT_NEAR(observation.idepth, decoy_disparity / shift, 0.02);
+}
+
+// Monte Carlo of the SSD observation variance when the image noise is 4 gray levels but the
+// model assumes sigma_I = 1: Engel's variance is overconfident, the residual-scaled one
+// (options.residual_intensity_noise) is consistent. Plane at 2 m, prior [0.3, 0.7] 1/m.
+TEST(EpipolarStereoTest, ResidualScaledNoiseKeepsTheObservationVarianceConsistent) {
+  const PinholeCamera camera = TestCamera();
+  const PlanePair pair = MakePlanePair(camera, 2.0, 5, 4.0);
+  const ImagePyramid ref(pair.ref, 1), cur(pair.cur, 1);
+  const EpipolarGeometry geometry(camera, pair.cur_from_ref);
+  auto within_2_sigma = [&](bool residual_noise, int* count) {
+    MappingOptions options;
+    options.sigma_intensity = 1.0;
+    options.sigma_epipolar_px = 0.05;
+    options.residual_intensity_noise = residual_noise;
+    int found = 0, within = 0;
+    for (int y = 10; y < camera.height - 10; y += 2) {
+      for (int x = 20; x < camera.width - 10; x += 2) {
+        const Eigen::Vector2d pixel(x, y);
+        EpipolarPatch patch;
+        StereoObservation observation;
+        if (MakeEpipolarPatch(ref, geometry, pixel, 0.5, options, &patch) != StereoStatus::kOk ||
+            SearchEpipolarSsd(cur, geometry, patch, pixel, 0.3, 0.7, options, &observation) !=
+                StereoStatus::kOk) {
+          continue;
+        }
+        ++found;
+        const double error = observation.idepth - 0.5;
+        within += error * error <= 4.0 * observation.idepth_var;
+      }
+    }
+    *count = found;
+    return static_cast<double>(within) / found;
+  };
+  int found_engel = 0, found_residual = 0;
+  const double engel = within_2_sigma(false, &found_engel);
+  const double residual = within_2_sigma(true, &found_residual);
+  std::printf("within 2 sigma: Engel %.3f (%d matches), residual-scaled %.3f (%d)\n", engel,
+              found_engel, residual, found_residual);
+  ASSERT_GT(found_residual, 1000);
+  EXPECT_GT(residual, 0.90);  // 0.954 if consistent
+  EXPECT_LT(engel, 0.80);
 }
 
 TEST(DepthPropagationTest, PlaneDepthIsPropagatedWithInflatedVariance) {
