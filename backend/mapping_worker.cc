@@ -2,6 +2,7 @@
 
 #include <glog/logging.h>
 
+#include <algorithm>
 #include <chrono>
 #include <exception>
 #include <utility>
@@ -11,12 +12,14 @@
 namespace pldvo {
 
 MappingWorker::MappingWorker(const PinholeCamera& camera, const MappingOptions& options,
-                             bool parallel, int max_pending_updates, bool wait_when_behind)
+                             bool parallel, int max_pending_updates, bool wait_when_behind,
+                             int inline_lag)
     : camera_(camera),
       options_(options),
       parallel_(parallel),
       max_pending_updates_(std::max(1, max_pending_updates)),
       wait_when_behind_(wait_when_behind),
+      inline_lag_(std::max(0, inline_lag)),
       mapper_(camera, options) {
   if (parallel_) thread_ = std::thread(&MappingWorker::ThreadLoop, this);
 }
@@ -34,7 +37,13 @@ MappingWorker::~MappingWorker() {
 
 double MappingWorker::Submit(MappingJob job) {
   if (!parallel_) {
-    Run(job);
+    if (job.kind == MappingJob::Kind::kUpdate) {
+      held_back_.push_back(std::move(job));
+      while (static_cast<int>(held_back_.size()) > inline_lag_) RunOldestHeldBack();
+    } else {
+      Flush();
+      Run(job);
+    }
     return 0.0;
   }
   double wait_ms = 0.0;
@@ -82,8 +91,17 @@ std::shared_ptr<const KeyframeMap> MappingWorker::WaitForKeyframe(int keyframe_i
   return latest_;
 }
 
+void MappingWorker::RunOldestHeldBack() {
+  const MappingJob job = std::move(held_back_.front());
+  held_back_.pop_front();
+  Run(job);
+}
+
 void MappingWorker::Flush() {
-  if (!parallel_) return;
+  if (!parallel_) {
+    while (!held_back_.empty()) RunOldestHeldBack();
+    return;
+  }
   std::unique_lock<std::mutex> lock(mutex_);
   job_done_.wait(lock, [&] { return queue_.empty() && !busy_; });
 }

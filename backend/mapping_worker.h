@@ -7,7 +7,8 @@
 //
 // Ordering: jobs run in submission order. When more than `max_pending_updates` frame updates wait
 // in parallel mode, the oldest waiting update is dropped (counted in dropped_updates()); keyframe
-// and line-depth jobs are never dropped.
+// and line-depth jobs are never dropped. Inline, frame updates can be held back by `inline_lag`
+// later submissions (the lag of a mapping thread, deterministically).
 #ifndef PLDVO_BACKEND_MAPPING_WORKER_H_
 #define PLDVO_BACKEND_MAPPING_WORKER_H_
 
@@ -76,15 +77,17 @@ class MappingWorker {
   // Throws std::invalid_argument on invalid camera or options.
   // With wait_when_behind, Submit blocks while max_pending_updates frame updates are pending
   // instead of dropping the oldest: the map then sees every frame whatever the machine's load.
+  // Inline (not parallel), an update runs once `inline_lag` later updates were submitted, or
+  // before the next keyframe or line-depth job, or at Flush.
   MappingWorker(const PinholeCamera& camera, const MappingOptions& options, bool parallel,
-                int max_pending_updates, bool wait_when_behind = false);
+                int max_pending_updates, bool wait_when_behind = false, int inline_lag = 0);
   ~MappingWorker();
   MappingWorker(const MappingWorker&) = delete;
   MappingWorker& operator=(const MappingWorker&) = delete;
 
-  // Runs the job inline (not parallel) or queues it. A job that throws is counted in
-  // failed_jobs() and leaves the map as it was. Returns the ms spent waiting for the mapping
-  // thread to catch up (wait_when_behind), else 0.
+  // Runs the job inline (not parallel; updates may be held back, see the constructor) or queues
+  // it. A job that throws is counted in failed_jobs() and leaves the map as it was. Returns the
+  // ms spent waiting for the mapping thread to catch up (wait_when_behind), else 0.
   double Submit(MappingJob job);
   // The latest published map (nullptr before the first keyframe).
   std::shared_ptr<const KeyframeMap> Latest() const;
@@ -105,6 +108,7 @@ class MappingWorker {
 
  private:
   void Run(const MappingJob& job);
+  void RunOldestHeldBack();
   void Publish(std::shared_ptr<KeyframeMap> keyframe_map);
   void ThreadLoop();
 
@@ -113,8 +117,10 @@ class MappingWorker {
   bool parallel_;
   int max_pending_updates_;
   bool wait_when_behind_;
-  DepthMapper mapper_;            // touched only by the job runner
-  ImagePyramid keyframe_levels_;  // the keyframe's pyramid for the reference intensities
+  int inline_lag_;
+  std::deque<MappingJob> held_back_;  // inline: updates waiting for inline_lag_ later ones
+  DepthMapper mapper_;                // touched only by the job runner
+  ImagePyramid keyframe_levels_;      // the keyframe's pyramid for the reference intensities
   int keyframe_id_ = -1;
   int num_updates_ = 0;
 

@@ -87,7 +87,8 @@ Odometry::Odometry(const PinholeCamera& camera, const OdometryConfig& config,
   }
   mapper_ = std::make_unique<MappingWorker>(
       camera_, config_.mapping, config_.odometry.parallel_mapping,
-      config_.odometry.mapping_queue_size, config_.odometry.wait_for_mapping);
+      config_.odometry.mapping_queue_size, config_.odometry.wait_for_mapping,
+      config_.odometry.inline_mapping_lag);
   const EdgeBAOptions& edge_ba = config_.backend.edge_ba;
   if (edge_ba.enabled) {
     edge_ba_window_ = std::make_unique<KeyframeWindow>(camera_, edge_ba.window,
@@ -434,6 +435,8 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, const cv::Mat
       result.compared = true;
       result.compared_status = other.status;
       result.world_from_cam_compared = keyframe_.world_from_kf * other.cur_from_ref.Inverse();
+      if (!other.levels.empty()) result.compared_final_cost = other.levels.back().final_cost;
+      result.compared_valid_residuals = other.valid_residuals;
     }
 
     if (tracking.status != TrackingStatus::kLost) {

@@ -96,6 +96,11 @@ struct OdometryOptions {
   // Mapping in its own thread (default). false: mapping runs on the caller's thread after each
   // frame, deterministic (the tests).
   bool parallel_mapping = true;
+  // parallel_mapping false: a frame's map update runs only after this many later frames were
+  // tracked, so the tracking sees a map that lags like the mapping thread's (0: the newest frame;
+  // with wait_for_mapping, once mapping is the bottleneck, the thread's schedule is a lag of
+  // mapping_queue_size + 1). Keyframe switches first run every held-back update, in order.
+  int inline_mapping_lag = 0;
   // Pending mapping updates kept when the mapping thread falls behind; older pending frames are
   // dropped (counted). Keyframe creations are never dropped.
   int mapping_queue_size = 2;
@@ -139,6 +144,8 @@ struct OdometryOptions {
             "Propagated hypotheses needed to keep the map on re-initialisation (default 500).");
     v.Field("parallel_mapping", &parallel_mapping,
             "Mapping in its own thread; false runs it inline (deterministic).");
+    v.Field("inline_mapping_lag", &inline_mapping_lag,
+            "parallel_mapping false: frames tracked before a frame's map update runs (default 0).");
     v.Field("mapping_queue_size", &mapping_queue_size,
             "Pending mapping updates kept when mapping falls behind (default 2).");
     v.Field("wait_for_mapping", &wait_for_mapping,

@@ -70,6 +70,10 @@ struct OdometryFrameResult {
   bool compared = false;
   TrackingStatus compared_status = TrackingStatus::kLost;
   SE3 world_from_cam_compared;  // its pose, with this run's keyframe pose
+  // Its finest level's final cost and valid rows (the run's: tracking.levels.back().final_cost,
+  // tracking.valid_residuals): which solver stopped lower where the poses differ.
+  double compared_final_cost = 0.0;
+  int compared_valid_residuals = 0;
 };
 
 // A keyframe whose map is final (replaced by a new keyframe, or the last one at Finish).

@@ -31,7 +31,11 @@ class SolverComparison {
   // max translation (m) and rotation (deg) differences, median ms of one tracking solve (the
   // final one; the run's tracking_ms also holds alternative guesses and re-tracking), and
   // with ground truth rpe_cm_s / rpe_deg_s / ate_m of the compared trajectory.
+  // `largest_differences`: the kLargestDifferences frames with the largest translation
+  // difference, largest first, each with both solvers' final cost and valid rows at the finest
+  // level (whether one solver stopped short or the two found different minima).
   nlohmann::json Summary(const Trajectory* ground_truth) const;
+  static constexpr int kLargestDifferences = 5;
   // One line for the run's final table.
   std::string Line(const nlohmann::json& summary) const;
 
@@ -39,7 +43,16 @@ class SolverComparison {
   std::ofstream file_;
   std::string solver_name_;
   Trajectory trajectory_;
-  std::vector<double> translation_diff_m_, rotation_diff_deg_;
+  struct FrameDifference {
+    int frame = 0;
+    double translation_m = 0.0;
+    double rotation_deg = 0.0;
+    double run_cost = 0.0;
+    double compared_cost = 0.0;
+    int run_valid_rows = 0;
+    int compared_valid_rows = 0;
+  };
+  std::vector<FrameDifference> differences_;
   std::vector<double> run_tracking_ms_, compare_tracking_ms_;
   int lost_ = 0;  // compared frames the other solver reported lost
 };

@@ -164,6 +164,11 @@ TEST(OdometryTest, CompareSolverSolvesTheSameProblemsWithoutChangingTheRun) {
     EXPECT_LT(difference.translation().norm(), 5e-4) << "frame " << frame.index;
     EXPECT_LT(Eigen::AngleAxisd(difference.rotation()).angle(), 1e-3) << "frame " << frame.index;
     EXPECT_GT(frame.timing.compare_tracking_ms, 0.0);
+    // The same problem at nearly the same pose: nearly the same final cost.
+    ASSERT_FALSE(frame.tracking.levels.empty());
+    const double run_cost = frame.tracking.levels.back().final_cost;
+    EXPECT_NEAR(frame.compared_final_cost, run_cost, 0.01 * run_cost) << "frame " << frame.index;
+    EXPECT_EQ(frame.compared_valid_residuals, frame.tracking.valid_residuals);
     compared.push_back({frame.timestamp, frame.world_from_cam_compared});
   }
   ASSERT_EQ(translation_diff.size(), static_cast<size_t>(kFrames - 1));

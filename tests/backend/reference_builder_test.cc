@@ -1,5 +1,5 @@
 // The tracking reference's point budget and edge foot points (reference_builder.h) and the
-// mapping worker's wait-instead-of-drop mode (mapping_worker.h).
+// mapping worker's wait-instead-of-drop mode and inline lag (mapping_worker.h).
 #include "backend/reference_builder.h"
 
 #include <gtest/gtest.h>
@@ -179,6 +179,30 @@ TEST(ReferenceBuilderTest, FootPointsReprojectOntoTheMatchedLinesAtTheTruePose) 
   EXPECT_GT(median(traced), 0.4);
 }
 
+// Mapping jobs on one textured image: a keyframe (new, or a switch new_from_old) and a frame
+// update at 1 cm per frame index along x.
+MappingJob KeyframeJob(MappingJob::Kind kind, int keyframe_id, int frame_index,
+                       const cv::Mat& image) {
+  MappingJob job;
+  job.kind = kind;
+  job.keyframe_id = keyframe_id;
+  job.frame_index = frame_index;
+  job.image = image;
+  job.num_levels = 3;
+  return job;
+}
+
+MappingJob UpdateJob(int keyframe_id, int frame_index, const cv::Mat& image) {
+  MappingJob update;
+  update.kind = MappingJob::Kind::kUpdate;
+  update.keyframe_id = keyframe_id;
+  update.frame_index = frame_index;
+  update.image = image;
+  update.cur_from_kf =
+      SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.01 * frame_index, 0.0, 0.0));
+  return update;
+}
+
 TEST(MappingWorkerTest, WaitingWhenBehindRunsEveryUpdate) {
   // A burst of updates submitted faster than the thread maps them: with wait_when_behind the
   // submitter blocks instead, so no update is dropped and every job runs.
@@ -186,29 +210,47 @@ TEST(MappingWorkerTest, WaitingWhenBehindRunsEveryUpdate) {
   MappingWorker worker(Camera(), options, /*parallel=*/true, /*max_pending_updates=*/1,
                        /*wait_when_behind=*/true);
   const cv::Mat image = Texture();
-  MappingJob init;
-  init.kind = MappingJob::Kind::kInitialize;
-  init.keyframe_id = 0;
-  init.frame_index = 0;
-  init.image = image;
-  init.num_levels = 3;
-  worker.Submit(std::move(init));
+  worker.Submit(KeyframeJob(MappingJob::Kind::kInitialize, 0, 0, image));
   constexpr int kUpdates = 30;
-  for (int i = 1; i <= kUpdates; ++i) {
-    MappingJob update;
-    update.kind = MappingJob::Kind::kUpdate;
-    update.keyframe_id = 0;
-    update.frame_index = i;
-    update.image = image;
-    update.cur_from_kf = SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.01 * i, 0.0, 0.0));
-    EXPECT_GE(worker.Submit(std::move(update)), 0.0);
-  }
+  for (int i = 1; i <= kUpdates; ++i) EXPECT_GE(worker.Submit(UpdateJob(0, i, image)), 0.0);
   worker.Flush();
   EXPECT_EQ(worker.dropped_updates(), 0);
   EXPECT_EQ(worker.failed_jobs(), 0);
   EXPECT_EQ(static_cast<int>(worker.JobTimesMs().size()), kUpdates + 1);
   ASSERT_NE(worker.Latest(), nullptr);
   EXPECT_EQ(worker.Latest()->num_updates, kUpdates);
+}
+
+TEST(MappingWorkerTest, InlineLagHoldsUpdatesBackUntilTheNextKeyframe) {
+  // Inline with a lag of 2: the published map holds every update but the newest two; a keyframe
+  // switch first runs the held-back ones, so the retired keyframe saw every frame.
+  constexpr int kLag = 2;
+  MappingOptions options;
+  MappingWorker worker(Camera(), options, /*parallel=*/false, /*max_pending_updates=*/2,
+                       /*wait_when_behind=*/true, kLag);
+  const cv::Mat image = Texture();
+  worker.Submit(KeyframeJob(MappingJob::Kind::kInitialize, 0, 0, image));
+  constexpr int kUpdates = 5;
+  for (int i = 1; i <= kUpdates; ++i) {
+    worker.Submit(UpdateJob(0, i, image));
+    ASSERT_NE(worker.Latest(), nullptr);
+    EXPECT_EQ(worker.Latest()->num_updates, std::max(0, i - kLag)) << "after update " << i;
+  }
+  MappingJob next = KeyframeJob(MappingJob::Kind::kNewKeyframe, 1, kUpdates + 1, image);
+  next.new_from_old = SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(-0.06, 0.0, 0.0));
+  next.keep_retired_map = true;
+  worker.Submit(std::move(next));
+  // Every job ran: the held-back updates before the switch (after it they would be skipped as
+  // updates of a retired keyframe, and not timed).
+  EXPECT_EQ(static_cast<int>(worker.JobTimesMs().size()), kUpdates + 2);
+  EXPECT_EQ(worker.failed_jobs(), 0);
+  ASSERT_NE(worker.Latest(), nullptr);
+  EXPECT_EQ(worker.Latest()->keyframe_id, 1);
+  EXPECT_EQ(worker.Latest()->num_updates, 0);
+  worker.Submit(UpdateJob(1, kUpdates + 2, image));
+  EXPECT_EQ(worker.Latest()->num_updates, 0);
+  worker.Flush();
+  EXPECT_EQ(worker.Latest()->num_updates, 1);
 }
 
 }  // namespace
