@@ -3,7 +3,8 @@
 # included) into ${PLDVO_ASAN_BUILD_DIR:-build-asan} and runs every test; any sanitizer report
 # fails its test. Usage: scripts/sanitize.sh [ctest args...]   (e.g. -R Trajectory)
 # ${PLDVO_ASAN_FLAGS:--O1 -g1} are the compile flags (.ci/run passes -O1 -g0). Prints the build
-# and test wall times. See docs/reliability.md.
+# and test wall times. ${PLDVO_ASAN_STACK_USE_AFTER_RETURN:-1}: ASan's detect_stack_use_after_return
+# (.ci/run passes 0). See docs/reliability.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install_deps.sh
@@ -23,7 +24,7 @@ echo "sanitize: build $((SECONDS - start)) s"
 
 # Every report is fatal: ASan and LSan exit non-zero at the first error (halt_on_error), UBSan
 # too (the build uses -fno-sanitize-recover=undefined; halt_on_error covers the rest).
-export ASAN_OPTIONS="halt_on_error=1:abort_on_error=0:detect_leaks=1:detect_stack_use_after_return=1:strict_string_checks=1:check_initialization_order=1:detect_odr_violation=2:exitcode=23"
+export ASAN_OPTIONS="halt_on_error=1:abort_on_error=0:detect_leaks=1:detect_stack_use_after_return=${PLDVO_ASAN_STACK_USE_AFTER_RETURN:-1}:strict_string_checks=1:check_initialization_order=1:detect_odr_violation=2:exitcode=23"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1:report_error_type=1"
 export LSAN_OPTIONS="exitcode=23:suppressions=$PWD/scripts/lsan_suppressions.txt:print_suppressions=0"
 start=$SECONDS
