@@ -57,8 +57,7 @@ struct RunResult {
   Trajectory estimate;  // tracked frames
 };
 
-// Runs the sequence; frames listed in `blank` are replaced by a constant gray image.
-// The first `frames` frames of the sequence, with the frames in `blank` replaced by a blank image.
+// Runs the first `frames` frames; frames listed in `blank` are replaced by a constant gray image.
 RunResult RunSequence(const OdometryConfig& config, const std::vector<int>& blank = {},
                       int frames = kFrames) {
   const RenderedSequence& rendered = Sequence();
