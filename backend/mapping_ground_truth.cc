@@ -163,11 +163,12 @@ cv::Mat InverseDepthFromDepth(const cv::Mat& depth) {
 }
 
 DepthErrorStats EvaluateDepthMap(const SemiDenseDepthMap& map, const cv::Mat& gt_idepth,
-                                 const cv::Mat& mask, bool require_observed) {
+                                 const cv::Mat& mask, bool require_observed, double scale) {
   if (gt_idepth.type() != CV_32F || gt_idepth.cols != map.width() ||
       gt_idepth.rows != map.height()) {
     throw std::invalid_argument("EvaluateDepthMap: gt_idepth must be CV_32F of the map's size");
   }
+  if (!(scale > 0.0)) throw std::invalid_argument("EvaluateDepthMap: scale must be > 0");
   std::vector<double> rel, nees;
   int within = 0;
   for (int y = 0; y < map.height(); ++y) {
@@ -177,10 +178,11 @@ DepthErrorStats EvaluateDepthMap(const SemiDenseDepthMap& map, const cv::Mat& gt
       if (!mask.empty() && mask.at<uint8_t>(y, x) == 0) continue;
       const double gt = gt_idepth.at<float>(y, x);
       if (!(gt > 0.0)) continue;
-      const double error = map.idepth(i) - gt;
+      const double error = scale * map.idepth(i) - gt;
+      const double var = scale * scale * map.idepth_var(i);
       rel.push_back(std::abs(error) / gt);
-      nees.push_back(error * error / map.idepth_var(i));
-      within += (error * error <= 4.0 * map.idepth_var(i));
+      nees.push_back(error * error / var);
+      within += (error * error <= 4.0 * var);
     }
   }
   DepthErrorStats stats;
@@ -206,6 +208,27 @@ DepthErrorStats EvaluateDepthMap(const SemiDenseDepthMap& map, const cv::Mat& gt
   stats.gross_fraction = 1.0 - static_cast<double>(bulk) / nees.size();
   if (bulk > 0) stats.bulk_mean_nees /= bulk;
   return stats;
+}
+
+double MedianInverseDepthRatio(const SemiDenseDepthMap& map, const cv::Mat& gt_idepth,
+                               bool require_observed) {
+  if (gt_idepth.type() != CV_32F || gt_idepth.cols != map.width() ||
+      gt_idepth.rows != map.height()) {
+    throw std::invalid_argument(
+        "MedianInverseDepthRatio: gt_idepth must be CV_32F of the map's size");
+  }
+  std::vector<double> ratios;
+  for (int y = 0; y < map.height(); ++y) {
+    for (int x = 0; x < map.width(); ++x) {
+      const int i = map.Index(x, y);
+      if (!map.valid(i) || (require_observed && map.num_observations(i) == 0)) continue;
+      const double gt = gt_idepth.at<float>(y, x);
+      if (gt > 0.0 && map.idepth(i) > 0.0) ratios.push_back(gt / map.idepth(i));
+    }
+  }
+  if (ratios.empty()) return 0.0;
+  std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
+  return ratios[ratios.size() / 2];
 }
 
 cv::Mat ContinuousDepthMask(const cv::Mat& gt_idepth, int radius, double max_rel_step) {

@@ -73,9 +73,15 @@ constexpr double kGrossNees = 10.83;
 cv::Mat ContinuousDepthMask(const cv::Mat& gt_idepth, int radius, double max_rel_step);
 
 // Statistics over the valid hypotheses with gt_idepth > 0 (CV_32F) and mask != 0 (CV_8U; empty =
-// everywhere); with require_observed only hypotheses with at least one stereo observation.
+// everywhere); with require_observed only hypotheses with at least one stereo observation. A
+// monocular map is compared after scaling: s d against d_gt, with variance s^2 V.
 DepthErrorStats EvaluateDepthMap(const SemiDenseDepthMap& map, const cv::Mat& gt_idepth,
-                                 const cv::Mat& mask, bool require_observed = true);
+                                 const cv::Mat& mask, bool require_observed = true,
+                                 double scale = 1.0);
+// The scale s = median(d_gt / d) of a monocular map over the hypotheses EvaluateDepthMap
+// evaluates (no mask), or 0 when there are none.
+double MedianInverseDepthRatio(const SemiDenseDepthMap& map, const cv::Mat& gt_idepth,
+                               bool require_observed = true);
 
 }  // namespace pldvo
 

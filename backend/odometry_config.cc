@@ -28,6 +28,8 @@ std::string OdometryOptions::Check() const {
 
 std::string OutputOptions::Check() const {
   if (iteration_images_every < 0) return "iteration_images_every must be >= 0";
+  if (!(discontinuity_rel_step > 0.0)) return "discontinuity_rel_step must be > 0";
+  if (discontinuity_radius_px < 0) return "discontinuity_radius_px must be >= 0";
   return "";
 }
 

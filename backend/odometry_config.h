@@ -172,6 +172,15 @@ struct OutputOptions {
   bool keyframe_depth_png = false;
   // The semi-dense points of every keyframe (world frame) as a PLY when it is retired.
   bool keyframe_ply = false;
+  // Every retired keyframe's map against the dataset's depth image of its frame (tum layout with
+  // depth.txt: synthetic sequences, TUM RGB-D, ICL-NUIM), after a median scale alignment, one
+  // row per keyframe in OUT/keyframe_maps.csv and medians in summary.json. Costs one depth-image
+  // read per keyframe on the tracking thread.
+  bool keyframe_map_error = false;
+  // Its `continuous` columns leave out pixels within this many pixels of a GT inverse-depth step
+  // larger than discontinuity_rel_step between 4-neighbours (as `pldvo mapeval`).
+  double discontinuity_rel_step = 0.02;
+  int discontinuity_radius_px = 3;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
@@ -181,6 +190,15 @@ struct OutputOptions {
             "Write each keyframe's inverse-depth map as PNG (default false).");
     v.Field("keyframe_ply", &keyframe_ply,
             "Write each keyframe's semi-dense points as PLY (default false).");
+    v.Field("keyframe_map_error", &keyframe_map_error,
+            "Evaluate each keyframe's map against the dataset's depth image (scale-aligned) into "
+            "keyframe_maps.csv and summary.json (default false).");
+    v.Field("discontinuity_rel_step", &discontinuity_rel_step,
+            "keyframe_map_error: a GT inverse-depth step between neighbours larger than this "
+            "fraction is a discontinuity (default 0.02).");
+    v.Field("discontinuity_radius_px", &discontinuity_radius_px,
+            "keyframe_map_error: pixels this close to a discontinuity are not `continuous` "
+            "(default 3).");
   }
   std::string Check() const;
 };

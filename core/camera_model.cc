@@ -328,7 +328,7 @@ Undistorter::Undistorter(const CameraModel& camera)
   cv::convertMaps(map_x, map_y, map_x_, map_y_, CV_16SC2);
 }
 
-cv::Mat Undistorter::Undistort(const cv::Mat& image) const {
+cv::Mat Undistorter::Remap(const cv::Mat& image, int interpolation) const {
   if (image.cols != input_size_.width || image.rows != input_size_.height) {
     std::ostringstream message;
     message << "Undistorter: image is " << image.cols << "x" << image.rows
@@ -337,9 +337,17 @@ cv::Mat Undistorter::Undistort(const cv::Mat& image) const {
   }
   if (identity_) return image;
   cv::Mat undistorted;
-  cv::remap(image, undistorted, map_x_, map_y_, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+  cv::remap(image, undistorted, map_x_, map_y_, interpolation, cv::BORDER_CONSTANT,
             cv::Scalar::all(0));
   return undistorted;
+}
+
+cv::Mat Undistorter::Undistort(const cv::Mat& image) const {
+  return Remap(image, cv::INTER_LINEAR);
+}
+
+cv::Mat Undistorter::UndistortNearest(const cv::Mat& image) const {
+  return Remap(image, cv::INTER_NEAREST);
 }
 
 }  // namespace pldvo

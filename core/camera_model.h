@@ -55,9 +55,14 @@ class Undistorter {
   // naming both sizes when the image size differs from the calibration. For a pinhole model the
   // returned Mat shares its data with `image`.
   cv::Mat Undistort(const cv::Mat& image) const;
+  // The same remap with nearest-neighbour sampling, for depth images: bilinear sampling would
+  // invent depths between the two surfaces at an occlusion boundary.
+  cv::Mat UndistortNearest(const cv::Mat& image) const;
   bool is_identity() const { return identity_; }
 
  private:
+  cv::Mat Remap(const cv::Mat& image, int interpolation) const;
+
   PinholeCamera input_size_;
   PinholeCamera output_camera_;
   bool identity_ = true;

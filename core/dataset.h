@@ -73,6 +73,11 @@ class Dataset {
   // image file when it is missing, unreadable or of the wrong size. Safe to call from several
   // threads.
   virtual Frame Load(int i) const = 0;
+  // The depth image of frame i as CV_32F metres (0 = no measurement), undistorted to camera()
+  // like the image; empty when the dataset has no depth for the frame (only the tum format has
+  // depth). Throws std::runtime_error naming the file when it is unreadable, not a 16-bit image
+  // or of the wrong size.
+  virtual cv::Mat LoadDepth(int /*i*/) const { return cv::Mat(); }
   // The undistorted pinhole camera of the images Load returns.
   virtual const PinholeCamera& camera() const = 0;
   // Camera-to-world (world_from_cam) poses of the camera() frame, or nullptr when the dataset

@@ -72,6 +72,8 @@ class Rectifier {
   const PinholeCamera& output() const { return undistorter_->output_camera(); }
   // `gray8` must be CV_8UC1 of the input size (checked by the caller, which knows the file).
   cv::Mat Rectify(const cv::Mat& gray8) const;
+  // A CV_32F depth image of the input size, undistorted with nearest-neighbour sampling.
+  cv::Mat RectifyDepth(const cv::Mat& depth) const { return undistorter_->UndistortNearest(depth); }
 
  private:
   std::unique_ptr<CameraModel> model_;

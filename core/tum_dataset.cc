@@ -3,6 +3,7 @@
 #include <glog/logging.h>
 
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
 #include "core/camera_yaml.h"
@@ -105,6 +106,19 @@ class TumDataset : public Dataset {
     frame.depth_path = depth_paths_[i];
     frame.image = rectifier_.Rectify(raw);
     return frame;
+  }
+
+  // TUM depth PNGs: 16-bit, metres x 5000 (docs/datasets.md).
+  cv::Mat LoadDepth(int i) const override {
+    const std::string& path = depth_paths_.at(i);
+    if (path.empty()) return cv::Mat();
+    const cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
+    if (raw.empty()) throw std::runtime_error(path + ": cannot read the depth image");
+    if (raw.type() != CV_16UC1) throw std::runtime_error(path + ": not a 16-bit depth PNG");
+    RequireSize(raw, rectifier_.input().width, rectifier_.input().height, path);
+    cv::Mat depth;
+    raw.convertTo(depth, CV_32F, 1.0 / 5000.0);
+    return rectifier_.RectifyDepth(depth);
   }
 
  private:

@@ -10,7 +10,9 @@
 //   OUT/summary.json     at the end: counts, median / mean ms per component, and with ground
 //                        truth rpe_cm_s, rpe_deg_s, ate_m, coverage (Sim(3)-aligned);
 //   OUT/trajectory_compare.txt  with odometry.compare_solver: the other solver's poses on the
-//                        same tracking problems (summary.json `compare_solver`).
+//                        same tracking problems (summary.json `compare_solver`);
+//   OUT/keyframe_maps.csv  with output.keyframe_map_error: each keyframe's map against the
+//                        dataset's depth (summary.json `keyframe_maps`).
 // A frame that fails to load is reported with its file, marked failed and skipped. Exit codes
 // (docs/reliability.md): 0 done; 1 a fatal input or output fault (dataset files, camera, output
 // folder, a failed write, no frame tracked at all); 2 a usage or config error.
@@ -31,7 +33,6 @@
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -139,18 +140,6 @@ LoadedFrame LoadFrame(const Dataset& dataset, int index) {
   return loaded;
 }
 
-// A TUM depth image (16-bit PNG, metres x 5000) as CV_32F metres; throws naming the file.
-cv::Mat LoadTumDepth(const std::string& path) {
-  if (path.empty()) throw std::runtime_error("odometry.init_depth_idepth_var: no depth image");
-  const cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (raw.empty() || raw.type() != CV_16U) {
-    throw std::runtime_error(path + ": not a 16-bit depth PNG");
-  }
-  cv::Mat depth;
-  raw.convertTo(depth, CV_32F, 1.0 / 5000.0);
-  return depth;
-}
-
 OdometryConfig LoadRunConfig(const CommandContext& context) {
   OdometryConfig config;
   if (!FLAGS_config.empty()) LoadConfigYaml(FLAGS_config, &config);
@@ -213,7 +202,7 @@ int RunOdometryCommand(const CommandContext& context) {
 
   const int num_frames =
       FLAGS_max_frames > 0 ? std::min(FLAGS_max_frames, dataset->size()) : dataset->size();
-  RunOutputs outputs(out, config.output);
+  RunOutputs outputs(out, config.output, dataset.get());
   std::unique_ptr<Odometry> odometry;
   try {
     odometry = std::make_unique<Odometry>(dataset->camera(), config, &outputs);
@@ -257,7 +246,12 @@ int RunOdometryCommand(const CommandContext& context) {
       try {
         cv::Mat depth;
         if (i == 0 && config.odometry.init_depth_idepth_var > 0.0) {
-          depth = LoadTumDepth(loaded.frame.depth_path);
+          depth = dataset->LoadDepth(i);
+          if (depth.empty()) {
+            throw std::runtime_error(
+                "odometry.init_depth_idepth_var: the dataset has no depth "
+                "image for frame 0");
+          }
         }
         result = odometry->ProcessFrame(i, loaded.frame.timestamp, loaded.frame.image, depth);
       } catch (const std::exception& e) {
@@ -371,6 +365,22 @@ int RunOdometryCommand(const CommandContext& context) {
       evaluation_line = std::string("evaluation failed: ") + e.what();
     }
   }
+  std::string map_line;
+  if (config.output.keyframe_map_error) {
+    summary["keyframe_maps"] = outputs.KeyframeMapSummary();
+    const nlohmann::json& maps = summary["keyframe_maps"];
+    std::ostringstream line;
+    if (maps.is_null()) {
+      line << "keyframe maps: none evaluated (no depth images?)";
+    } else {
+      line << std::setprecision(3) << "keyframe maps (" << maps["keyframes"].get<int>()
+           << ", medians): rel. err " << maps["median_rel_error_median"].get<double>()
+           << ", continuous: rel. err " << maps["continuous_median_rel_error_median"].get<double>()
+           << ", mean NEES " << maps["continuous_mean_nees_median"].get<double>() << ", gross "
+           << maps["continuous_gross_fraction_median"].get<double>();
+    }
+    map_line = line.str();
+  }
   std::string comparison_line;
   if (comparison != nullptr) {
     summary["compare_solver"] = comparison->Summary(ground_truth);
@@ -397,6 +407,7 @@ int RunOdometryCommand(const CommandContext& context) {
   }
   if (!evaluation_line.empty()) std::cout << "  " << evaluation_line << "\n";
   if (!comparison_line.empty()) std::cout << "  " << comparison_line << "\n";
+  if (!map_line.empty()) std::cout << "  " << map_line << "\n";
   std::cout << "  outputs in " << out << "\n";
   if (num_frames > 0 && stats.tracked == 0) {
     std::cerr << "pldvo run: no frame was tracked (" << failed

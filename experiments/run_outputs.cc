@@ -1,8 +1,10 @@
 #include "experiments/run_outputs.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -29,10 +31,30 @@ void DrawPixels(const std::vector<Eigen::Vector2d>& pixels, const cv::Vec3b& col
   }
 }
 
+constexpr const char* kStatColumns[] = {"count",         "median_rel_error", "mean_nees",
+                                        "median_nees",   "within_2sigma",    "gross_fraction",
+                                        "bulk_mean_nees"};
+
+std::vector<double> StatValues(const DepthErrorStats& s) {
+  return {static_cast<double>(s.count),
+          s.median_rel_error,
+          s.mean_nees,
+          s.median_nees,
+          s.within_2sigma,
+          s.gross_fraction,
+          s.bulk_mean_nees};
+}
+
+double MedianOf(std::vector<double> values) {
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
 }  // namespace
 
-RunOutputs::RunOutputs(const std::string& out_dir, const OutputOptions& options)
-    : out_dir_(out_dir), options_(options) {}
+RunOutputs::RunOutputs(const std::string& out_dir, const OutputOptions& options,
+                       const Dataset* dataset)
+    : out_dir_(out_dir), options_(options), dataset_(dataset) {}
 
 void RunOutputs::ReportError(const std::string& what) {
   if (error_reported_) return;
@@ -75,23 +97,82 @@ void RunOutputs::OnTrackingIteration(int frame_index, const cv::Mat& image,
 }
 
 bool RunOutputs::WantsKeyframeMaps() const {
-  return options_.keyframe_depth_png || options_.keyframe_ply;
+  return options_.keyframe_depth_png || options_.keyframe_ply || options_.keyframe_map_error;
 }
 
 void RunOutputs::OnKeyframeFinished(const KeyframeInfo& keyframe, const SemiDenseDepthMap& map) {
   try {
-    const std::string dir = out_dir_ + "/keyframes";
-    std::filesystem::create_directories(dir);
-    const std::string stem = dir + Numbered("/kf_%04d", keyframe.keyframe_id);
-    if (options_.keyframe_depth_png) WriteInverseDepthPng(map, stem + "_idepth.png");
-    if (options_.keyframe_ply) {
-      WritePointCloudPly(map, keyframe.image, keyframe.camera, keyframe.world_from_kf,
-                         stem + ".ply");
+    if (options_.keyframe_depth_png || options_.keyframe_ply) {
+      const std::string dir = out_dir_ + "/keyframes";
+      std::filesystem::create_directories(dir);
+      const std::string stem = dir + Numbered("/kf_%04d", keyframe.keyframe_id);
+      if (options_.keyframe_depth_png) WriteInverseDepthPng(map, stem + "_idepth.png");
+      if (options_.keyframe_ply) {
+        WritePointCloudPly(map, keyframe.image, keyframe.camera, keyframe.world_from_kf,
+                           stem + ".ply");
+      }
+      ++keyframes_written_;
     }
-    ++keyframes_written_;
+    if (options_.keyframe_map_error) EvaluateKeyframeMap(keyframe, map);
   } catch (const std::exception& e) {
     ReportError(e.what());
   }
+}
+
+void RunOutputs::EvaluateKeyframeMap(const KeyframeInfo& keyframe, const SemiDenseDepthMap& map) {
+  const cv::Mat depth = dataset_ != nullptr ? dataset_->LoadDepth(keyframe.frame_index) : cv::Mat();
+  if (depth.empty()) {
+    ReportError("output.keyframe_map_error: no depth image for frame " +
+                std::to_string(keyframe.frame_index));
+    return;
+  }
+  const cv::Mat gt_idepth = InverseDepthFromDepth(depth);
+  KeyframeMapError error;
+  error.keyframe_id = keyframe.keyframe_id;
+  error.frame_index = keyframe.frame_index;
+  error.timestamp = keyframe.timestamp;
+  error.scale = MedianInverseDepthRatio(map, gt_idepth);
+  if (!(error.scale > 0.0)) return;  // no observed hypothesis with depth: nothing to compare
+  error.all = EvaluateDepthMap(map, gt_idepth, cv::Mat(), true, error.scale);
+  const cv::Mat continuous = ContinuousDepthMask(gt_idepth, options_.discontinuity_radius_px,
+                                                 options_.discontinuity_rel_step);
+  error.continuous = EvaluateDepthMap(map, gt_idepth, continuous, true, error.scale);
+  map_errors_.push_back(error);
+
+  if (!map_error_file_.is_open()) {
+    map_error_file_.open(out_dir_ + "/keyframe_maps.csv");
+    map_error_file_ << "keyframe_id,frame_index,timestamp,scale";
+    for (const char* prefix : {"", "continuous_"}) {
+      for (const char* column : kStatColumns) map_error_file_ << "," << prefix << column;
+    }
+    map_error_file_ << "\n";
+  }
+  map_error_file_ << error.keyframe_id << "," << error.frame_index << "," << std::setprecision(17)
+                  << error.timestamp << "," << std::setprecision(6) << error.scale;
+  for (const DepthErrorStats* stats : {&error.all, &error.continuous}) {
+    for (double value : StatValues(*stats)) map_error_file_ << "," << value;
+  }
+  map_error_file_ << std::endl;
+  if (!map_error_file_) ReportError("cannot write " + out_dir_ + "/keyframe_maps.csv");
+}
+
+nlohmann::json RunOutputs::KeyframeMapSummary() const {
+  if (map_errors_.empty()) return nullptr;
+  nlohmann::json summary;
+  summary["keyframes"] = map_errors_.size();
+  std::vector<double> scales;
+  for (const KeyframeMapError& e : map_errors_) scales.push_back(e.scale);
+  summary["scale_median"] = MedianOf(scales);
+  for (const char* prefix : {"", "continuous_"}) {
+    for (size_t k = 1; k < std::size(kStatColumns); ++k) {
+      std::vector<double> column;
+      for (const KeyframeMapError& e : map_errors_) {
+        column.push_back(StatValues(*prefix == '\0' ? e.all : e.continuous)[k]);
+      }
+      summary[std::string(prefix) + kStatColumns[k] + "_median"] = MedianOf(column);
+    }
+  }
+  return summary;
 }
 
 }  // namespace pldvo

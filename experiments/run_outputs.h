@@ -4,23 +4,42 @@
 //       keyframe's edge points reprojected with the iteration's pose (green) over the current
 //       frame, the initial pose's reprojection of the level in red (the paper's Fig. 2);
 //   OUT/keyframes/kf_KKKK_idepth.png        the keyframe's inverse-depth map (colour, JET);
-//   OUT/keyframes/kf_KKKK.ply               its semi-dense points in the world frame.
+//   OUT/keyframes/kf_KKKK.ply               its semi-dense points in the world frame;
+//   OUT/keyframe_maps.csv                   each keyframe's map against the dataset's depth
+//       image (scale-aligned median relative error, NEES; all pixels and `continuous` ones).
 // Write failures are reported once to stderr and never stop the run.
 #ifndef PLDVO_EXPERIMENTS_RUN_OUTPUTS_H_
 #define PLDVO_EXPERIMENTS_RUN_OUTPUTS_H_
 
 #include <Eigen/Core>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
+#include "backend/mapping_ground_truth.h"
 #include "backend/odometry_config.h"
 #include "backend/odometry_observer.h"
+#include "core/dataset.h"
 
 namespace pldvo {
 
+// A retired keyframe's map against the GT depth of its frame (output.keyframe_map_error). `scale`
+// = median(d_gt / d) aligns the monocular map; `continuous` leaves out GT discontinuities.
+struct KeyframeMapError {
+  int keyframe_id = -1;
+  int frame_index = -1;
+  double timestamp = 0.0;
+  double scale = 0.0;
+  DepthErrorStats all;
+  DepthErrorStats continuous;
+};
+
 class RunOutputs : public OdometryObserver {
  public:
-  RunOutputs(const std::string& out_dir, const OutputOptions& options);
+  // `dataset` gives the depth images for keyframe_map_error (may be null when that is off).
+  RunOutputs(const std::string& out_dir, const OutputOptions& options,
+             const Dataset* dataset = nullptr);
 
   bool WantsTrackingIterations(int frame_index) const override;
   void OnTrackingIteration(int frame_index, const cv::Mat& image,
@@ -30,9 +49,14 @@ class RunOutputs : public OdometryObserver {
 
   int images_written() const { return images_written_; }
   int keyframes_written() const { return keyframes_written_; }
+  const std::vector<KeyframeMapError>& keyframe_map_errors() const { return map_errors_; }
+  // summary.json's `keyframe_maps`: the keyframes evaluated and the median over them of each
+  // statistic; null when none was.
+  nlohmann::json KeyframeMapSummary() const;
 
  private:
   void ReportError(const std::string& what);
+  void EvaluateKeyframeMap(const KeyframeInfo& keyframe, const SemiDenseDepthMap& map);
 
   std::string out_dir_;
   OutputOptions options_;
@@ -43,6 +67,9 @@ class RunOutputs : public OdometryObserver {
   int images_written_ = 0;
   int keyframes_written_ = 0;
   bool error_reported_ = false;
+  const Dataset* dataset_ = nullptr;
+  std::ofstream map_error_file_;
+  std::vector<KeyframeMapError> map_errors_;
 };
 
 }  // namespace pldvo

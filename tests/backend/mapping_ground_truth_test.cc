@@ -57,6 +57,38 @@ TEST(EvaluateDepthMapTest, GrossErrorsAreSeparatedFromTheBulk) {
   EXPECT_NEAR(stats.bulk_mean_nees, 0.988, 0.05);
 }
 
+TEST(EvaluateDepthMapTest, MonocularMapIsComparedAfterItsMedianScale) {
+  // A consistent map (as above) of a scene at twice the true scale: inverse depths and sigmas
+  // halved. MedianInverseDepthRatio recovers the factor 2, and the scaled evaluation gives the
+  // statistics of the metric map; unscaled, every pixel is off by half its inverse depth.
+  SemiDenseDepthMap metric = AllCandidates(200, 200), half = AllCandidates(200, 200);
+  cv::Mat gt(200, 200, CV_32F);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> idepth(0.3, 2.0);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  for (int i = 0; i < metric.num_pixels(); ++i) {
+    const double d_gt = idepth(rng), sigma = 0.01 * d_gt, d = d_gt + sigma * unit(rng);
+    gt.at<float>(i / 200, i % 200) = static_cast<float>(d_gt);
+    metric.Set(i, d, sigma * sigma, 20);
+    half.Set(i, d / 2.0, sigma * sigma / 4.0, 20);
+    metric.CountObservation(i);
+    half.CountObservation(i);
+  }
+  EXPECT_NEAR(MedianInverseDepthRatio(metric, gt), 1.0, 1e-3);
+  const double scale = MedianInverseDepthRatio(half, gt);
+  EXPECT_NEAR(scale, 2.0, 2e-3);
+  const DepthErrorStats expected = EvaluateDepthMap(metric, gt, cv::Mat());
+  const DepthErrorStats aligned = EvaluateDepthMap(half, gt, cv::Mat(), true, scale);
+  EXPECT_NEAR(aligned.mean_nees, expected.mean_nees, 0.02);
+  EXPECT_NEAR(aligned.median_rel_error, expected.median_rel_error, 5e-4);
+  EXPECT_NEAR(aligned.within_2sigma, expected.within_2sigma, 0.005);
+  EXPECT_NEAR(EvaluateDepthMap(half, gt, cv::Mat()).median_rel_error, 0.5, 0.01);
+  // Hypotheses without a stereo observation are left out of the ratio.
+  SemiDenseDepthMap unobserved = AllCandidates(200, 200);
+  unobserved.Set(0, 1.0, 0.01, 20);
+  EXPECT_EQ(MedianInverseDepthRatio(unobserved, gt), 0.0);
+}
+
 TEST(ContinuousDepthMaskTest, CutsAroundStepsAndKeepsSlantedPlanes) {
   // Left half: a plane slanted 60 degrees (relative idepth step per pixel ~0.6%); right half: 10%
   // further away; a hole of no depth at the bottom-left.

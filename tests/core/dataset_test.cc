@@ -147,6 +147,49 @@ TEST_F(DatasetTest, TumDistortedCameraIsUndistorted) {
   EXPECT_EQ(cv::norm(dataset->Load(1).image, undistorter.Undistort(raw), cv::NORM_INF), 0.0);
 }
 
+TEST_F(DatasetTest, TumDepthIsReadInMetresAndUndistortedWithoutMixingSurfaces) {
+  MakeTum();
+  // Frame 0: a depth step (1 m left, 2 m right, x 5000 as in TUM) and a hole without depth.
+  cv::Mat raw(30, 40, CV_16UC1);
+  for (int y = 0; y < raw.rows; ++y) {
+    for (int x = 0; x < raw.cols; ++x) raw.at<uint16_t>(y, x) = x < 20 ? 5000 : 10000;
+  }
+  raw(cv::Rect(5, 5, 4, 4)).setTo(0);
+  WriteImage("tum/depth/0.png", raw);
+  cv::Mat metres;
+  raw.convertTo(metres, CV_32F, 1.0 / 5000.0);
+  {
+    const auto dataset = OpenDataset(Path("tum"));
+    const cv::Mat depth = dataset->LoadDepth(0);
+    ASSERT_EQ(depth.type(), CV_32F);
+    EXPECT_EQ(cv::norm(depth, metres, cv::NORM_INF), 0.0);
+    EXPECT_TRUE(dataset->LoadDepth(2).empty());  // no depth image associated with frame 2
+    // Listed but missing (frame 1), and not 16-bit: errors naming the file.
+    EXPECT_THAT(ErrorOf([&] { dataset->LoadDepth(1); }), HasSubstr(Path("tum/depth/1.png")));
+    WriteImage("tum/depth/1.png", Pattern(40, 30, 0));
+    EXPECT_THAT(ErrorOf([&] { dataset->LoadDepth(1); }),
+                AllOf(HasSubstr(Path("tum/depth/1.png")), HasSubstr("16-bit")));
+  }
+  // A distorted camera: the depth goes through the image's undistortion with nearest-neighbour
+  // sampling, so every output value is one of the input's (no depth between the two surfaces).
+  PinholeCamera pinhole{40, 30, 50.0, 50.0, 19.5, 14.5};
+  const auto model = MakeCameraModel("radtan", pinhole, {-0.2, 0.05, 0.001, -0.001, 0.0});
+  WriteCameraYaml(*model, Path("tum/camera.yaml"));
+  const cv::Mat depth = OpenDataset(Path("tum"))->LoadDepth(0);
+  EXPECT_EQ(cv::norm(depth, Undistorter(*model).UndistortNearest(metres), cv::NORM_INF), 0.0);
+  int ones = 0, twos = 0;
+  for (int y = 0; y < depth.rows; ++y) {
+    for (int x = 0; x < depth.cols; ++x) {
+      const float d = depth.at<float>(y, x);
+      ASSERT_TRUE(d == 0.f || d == 1.f || d == 2.f) << d << " at " << x << ", " << y;
+      ones += d == 1.f;
+      twos += d == 2.f;
+    }
+  }
+  EXPECT_GT(ones, 200);
+  EXPECT_GT(twos, 200);
+}
+
 TEST_F(DatasetTest, TumCameraOptionOverridesTheFolder) {
   MakeTum();
   fs::remove(Path("tum/camera.yaml"));

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -142,6 +143,78 @@ TEST(RunCommandTest, CorruptFrameIsSkippedAndTheTrajectorySurvives) {
   const nlohmann::json summary = nlohmann::json::parse(Slurp(out / "summary.json"));
   EXPECT_EQ(summary["failed_frames"], 1);
   EXPECT_EQ(summary["lost_events"], 1);
+}
+
+// Rows of a CSV file with a header line, each split at commas.
+std::vector<std::vector<std::string>> CsvRows(const fs::path& path) {
+  std::vector<std::vector<std::string>> rows;
+  std::ifstream file(path);
+  std::string line;
+  std::getline(file, line);  // header
+  while (std::getline(file, line)) {
+    std::vector<std::string> fields;
+    std::stringstream stream(line);
+    std::string field;
+    while (std::getline(stream, field, ',')) fields.push_back(field);
+    rows.push_back(fields);
+  }
+  return rows;
+}
+
+// output.keyframe_map_error: every keyframe's map against the rendered depth. From the GT depth
+// the scale is 1 and the error is that of the filter under tracked poses; monocularly the scale is
+// free and comes out as whatever the random initial map gave.
+TEST(RunCommandTest, KeyframeMapsAreEvaluatedAgainstTheDepthImages) {
+  const char* const kMapError = " --set output.keyframe_map_error=true";
+  const fs::path out = TestRoot() / "run_maps";
+  ASSERT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " + out.string() +
+                      kDeterministic + kMapError + " --set odometry.init_depth_idepth_var=0.0001",
+                  TestRoot() / "run_maps.log"),
+            0)
+      << Slurp(TestRoot() / "run_maps.log");
+  const nlohmann::json summary = nlohmann::json::parse(Slurp(out / "summary.json"));
+  const std::vector<std::vector<std::string>> rows = CsvRows(out / "keyframe_maps.csv");
+  // Every keyframe, the last one at the end of the run included.
+  ASSERT_EQ(static_cast<int>(rows.size()), summary["keyframes"].get<int>());
+  for (const std::vector<std::string>& row : rows) {
+    ASSERT_EQ(row.size(), 18u);
+    std::printf("keyframe %s (frame %s): scale %s, %s px, median rel. err %s, median NEES %s\n",
+                row[0].c_str(), row[1].c_str(), row[3].c_str(), row[4].c_str(), row[5].c_str(),
+                row[7].c_str());
+    EXPECT_NEAR(std::stod(row[3]), 1.0, 0.02) << "scale of keyframe " << row[0];
+    EXPECT_GT(std::stoi(row[4]), 1000) << "evaluated pixels of keyframe " << row[0];
+    EXPECT_LT(std::stod(row[5]), 0.03) << "median relative error of keyframe " << row[0];
+  }
+  const nlohmann::json& maps = summary["keyframe_maps"];
+  ASSERT_TRUE(maps.is_object());
+  EXPECT_EQ(maps["keyframes"].get<size_t>(), rows.size());
+  EXPECT_NEAR(maps["scale_median"].get<double>(), 1.0, 0.02);
+
+  const fs::path mono = TestRoot() / "run_maps_mono";
+  ASSERT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " + mono.string() +
+                      kDeterministic + kMapError,
+                  TestRoot() / "run_maps_mono.log"),
+            0);
+  const std::vector<std::vector<std::string>> mono_rows = CsvRows(mono / "keyframe_maps.csv");
+  ASSERT_FALSE(mono_rows.empty());
+  EXPECT_GT(std::stod(mono_rows[0][3]), 0.0);
+
+  // A dataset without depth images: the run is not affected, and says so.
+  const fs::path no_depth = TestRoot() / "no_depth";
+  fs::remove_all(no_depth);
+  fs::copy(SequenceDir(), no_depth, fs::copy_options::recursive);
+  fs::remove(no_depth / "depth.txt");
+  const fs::path out_no_depth = TestRoot() / "run_maps_no_depth";
+  ASSERT_EQ(Pldvo("run --dataset " + no_depth.string() + " --out " + out_no_depth.string() +
+                      kDeterministic + kMapError + " --max_frames 12",
+                  TestRoot() / "run_maps_no_depth.log"),
+            0);
+  EXPECT_NE(Slurp(TestRoot() / "run_maps_no_depth.log").find("no depth image for frame 0"),
+            std::string::npos)
+      << Slurp(TestRoot() / "run_maps_no_depth.log");
+  EXPECT_TRUE(
+      nlohmann::json::parse(Slurp(out_no_depth / "summary.json"))["keyframe_maps"].is_null());
+  EXPECT_FALSE(fs::exists(out_no_depth / "keyframe_maps.csv"));
 }
 
 TEST(RunCommandTest, UnknownConfigKeyIsAnError) {
