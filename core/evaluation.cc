@@ -36,7 +36,10 @@ int NearestPose(const Trajectory& trajectory, double t) {
   return best;
 }
 
+}  // namespace
+
 double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
   const size_t mid = values.size() / 2;
   std::nth_element(values.begin(), values.begin() + mid, values.end());
   double median = values[mid];
@@ -45,8 +48,6 @@ double Median(std::vector<double> values) {
   }
   return median;
 }
-
-}  // namespace
 
 Sim3Alignment AlignUmeyama(const std::vector<Eigen::Vector3d>& src,
                            const std::vector<Eigen::Vector3d>& dst, bool with_scale) {

@@ -24,6 +24,9 @@ struct Sim3Alignment {
   }
 };
 
+// The median, the mean of the two middle values for an even count; 0 for no values.
+double Median(std::vector<double> values);
+
 // The closed-form least-squares similarity (Umeyama, PAMI 1991, eqs. 40-42) minimising
 // sum_i |dst_i - (s R src_i + t)|^2; with_scale = false fixes s = 1 (SE(3) alignment).
 // Throws std::invalid_argument for fewer than 3 pairs, different sizes, or all src points equal.

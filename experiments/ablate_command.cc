@@ -140,12 +140,6 @@ double JsonNumber(const nlohmann::json& json, const char* key) {
   return std::nan("");
 }
 
-double Median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const size_t n = values.size();
-  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
 std::string Fixed(double value, int precision) {
   if (!std::isfinite(value)) return "";
   std::ostringstream out;

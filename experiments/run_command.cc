@@ -74,17 +74,6 @@ std::vector<double> Values(const TimingRow& row) {
           row.wait, row.reference, row.tracking,  row.mapping,     row.tracking_thread, row.total};
 }
 
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  double median = values[mid];
-  if (values.size() % 2 == 0) {
-    median = 0.5 * (median + *std::max_element(values.begin(), values.begin() + mid));
-  }
-  return median;
-}
-
 double Mean(const std::vector<double>& values) {
   if (values.empty()) return 0.0;
   double sum = 0.0;

@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "backend/depth_map_io.h"
+#include "core/evaluation.h"
 
 namespace pldvo {
 namespace {
@@ -43,11 +44,6 @@ std::vector<double> StatValues(const DepthErrorStats& s) {
           s.within_2sigma,
           s.gross_fraction,
           s.bulk_mean_nees};
-}
-
-double MedianOf(std::vector<double> values) {
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
 }
 
 }  // namespace
@@ -162,14 +158,14 @@ nlohmann::json RunOutputs::KeyframeMapSummary() const {
   summary["keyframes"] = map_errors_.size();
   std::vector<double> scales;
   for (const KeyframeMapError& e : map_errors_) scales.push_back(e.scale);
-  summary["scale_median"] = MedianOf(scales);
+  summary["scale_median"] = Median(scales);
   for (const char* prefix : {"", "continuous_"}) {
     for (size_t k = 1; k < std::size(kStatColumns); ++k) {
       std::vector<double> column;
       for (const KeyframeMapError& e : map_errors_) {
         column.push_back(StatValues(*prefix == '\0' ? e.all : e.continuous)[k]);
       }
-      summary[std::string(prefix) + kStatColumns[k] + "_median"] = MedianOf(column);
+      summary[std::string(prefix) + kStatColumns[k] + "_median"] = Median(column);
     }
   }
   return summary;
