@@ -1,5 +1,7 @@
 #include "backend/odometry_config.h"
 
+#include <cmath>
+
 namespace pldvo {
 
 std::string KeyframeOptions::Check() const {
@@ -23,6 +25,14 @@ std::string OdometryOptions::Check() const {
   if (mapping_queue_size < 1) return "mapping_queue_size must be >= 1";
   if (inline_mapping_lag < 0) return "inline_mapping_lag must be >= 0";
   if (!(init_depth_idepth_var >= 0.0)) return "init_depth_idepth_var must be >= 0";
+  if (bootstrap_passes < 1) return "bootstrap_passes must be >= 1";
+  if (!(bootstrap_idepth_var > 0.0) || !std::isfinite(bootstrap_idepth_var)) {
+    return "bootstrap_idepth_var must be positive and finite";
+  }
+  if (bootstrap_passes > 1 && init_depth_idepth_var > 0.0) {
+    return "bootstrap_passes > 1 refines the monocular start and cannot be combined with "
+           "init_depth_idepth_var";
+  }
   return "";
 }
 

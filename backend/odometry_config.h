@@ -112,6 +112,13 @@ struct OdometryOptions {
   // first frame's depth image (TUM layout: 16-bit PNG, metres x 5000) with this inverse-depth
   // variance, which fixes the scale and removes the monocular initialisation; 0 = off.
   double init_depth_idepth_var = 0.0;
+  // Bootstrap refinement (backend/bootstrap_refiner.h), monocular runs: before the run, this many
+  // passes minus one over the first keyframe's frames, each starting from the map the previous
+  // one ended with (the first from the random map); the run then starts from the last map with
+  // inverse-depth variance bootstrap_idepth_var, relative to a median inverse depth of 1.
+  // 1 = off (default).
+  int bootstrap_passes = 1;
+  double bootstrap_idepth_var = 0.05;
   // Solver comparison (docs/tracking.md): every tracked frame's final tracking problem (the same
   // reference, lines and initial pose) is solved a second time with this solver; its poses, RPE
   // and time are reported beside the run's (summary.json `compare_solver`,
@@ -153,6 +160,12 @@ struct OdometryOptions {
     v.Field("init_depth_idepth_var", &init_depth_idepth_var,
             "Evaluation aid: > 0 initialises the first keyframe from the dataset's depth image "
             "with this inverse-depth variance, (1/m)^2; 0 = monocular random init (default).");
+    v.Field("bootstrap_passes", &bootstrap_passes,
+            "Monocular: passes over the first keyframe's frames, each re-estimating its map from "
+            "the previous pass's map; the run starts from the last (1 = off, default).");
+    v.Field("bootstrap_idepth_var", &bootstrap_idepth_var,
+            "Inverse-depth variance of a refined start map, median inverse depth scaled to 1 "
+            "(default 0.05).");
     v.Choice("compare_solver", &compare_solver,
              ChoiceNames<CompareSolver>{{"none", CompareSolver::kNone},
                                         {"ceres", CompareSolver::kCeres},

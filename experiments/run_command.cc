@@ -37,6 +37,7 @@
 #include <string>
 #include <vector>
 
+#include "backend/bootstrap_refiner.h"
 #include "backend/odometry.h"
 #include "backend/odometry_config.h"
 #include "core/config_io.h"
@@ -192,9 +193,27 @@ int RunOdometryCommand(const CommandContext& context) {
   const int num_frames =
       FLAGS_max_frames > 0 ? std::min(FLAGS_max_frames, dataset->size()) : dataset->size();
   RunOutputs outputs(out, config.output, dataset.get());
+  // odometry.bootstrap_passes: the run starts from the refined first map instead of a random one
+  // (or from the random one, said so, when the refinement fails).
+  BootstrapRefinement bootstrap;
+  OdometryConfig run_config = config;
+  run_config.odometry.bootstrap_passes = 1;
+  if (config.odometry.bootstrap_passes > 1 && num_frames > 0) {
+    try {
+      bootstrap = RefineBootstrap(*dataset, config, num_frames);
+      run_config.odometry.init_depth_idepth_var = config.odometry.bootstrap_idepth_var;
+      std::cerr << "pldvo run: bootstrap refinement: " << bootstrap.frames.size()
+                << " passes before the run, first keyframe hypotheses " << bootstrap.points.back()
+                << ", " << static_cast<int>(bootstrap.ms) << " ms\n";
+    } catch (const std::exception& e) {
+      bootstrap = BootstrapRefinement();
+      std::cerr << "pldvo run: bootstrap refinement failed (" << e.what()
+                << "); the run starts from the random map\n";
+    }
+  }
   std::unique_ptr<Odometry> odometry;
   try {
-    odometry = std::make_unique<Odometry>(dataset->camera(), config, &outputs);
+    odometry = std::make_unique<Odometry>(dataset->camera(), run_config, &outputs);
   } catch (const std::exception& e) {
     std::cerr << "pldvo run: " << e.what() << "\n";
     return 1;
@@ -234,7 +253,9 @@ int RunOdometryCommand(const CommandContext& context) {
     } else {
       try {
         cv::Mat depth;
-        if (i == 0 && config.odometry.init_depth_idepth_var > 0.0) {
+        if (i == 0 && !bootstrap.depth.empty()) {
+          depth = bootstrap.depth;
+        } else if (i == 0 && config.odometry.init_depth_idepth_var > 0.0) {
           depth = dataset->LoadDepth(i);
           if (depth.empty()) {
             throw std::runtime_error(
@@ -306,6 +327,13 @@ int RunOdometryCommand(const CommandContext& context) {
   summary["failed_mapping_jobs"] = stats.failed_mapping_jobs;
   summary["parallel_mapping"] = config.odometry.parallel_mapping;
   summary["seconds"] = run_seconds;
+  // odometry.bootstrap_passes > 1: frames and first-keyframe hypotheses per refinement pass, and
+  // their wall time (before the run; not in `seconds`).
+  summary["bootstrap"] = nullptr;
+  if (!bootstrap.frames.empty()) {
+    summary["bootstrap"] = {
+        {"frames", bootstrap.frames}, {"points", bootstrap.points}, {"ms", bootstrap.ms}};
+  }
   summary["fps"] = run_seconds > 0.0 ? num_frames / run_seconds : 0.0;
   // Edge bundle adjustment (backend.edge_ba): windows solved, applied, CPU ms per window.
   summary["edge_ba_windows"] = stats.edge_ba_windows;

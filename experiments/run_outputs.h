@@ -49,7 +49,6 @@ class RunOutputs : public OdometryObserver {
 
   int images_written() const { return images_written_; }
   int keyframes_written() const { return keyframes_written_; }
-  const std::vector<KeyframeMapError>& keyframe_map_errors() const { return map_errors_; }
   // summary.json's `keyframe_maps`: the keyframes evaluated and the median over them of each
   // statistic; null when none was.
   nlohmann::json KeyframeMapSummary() const;

@@ -217,6 +217,72 @@ TEST(RunCommandTest, KeyframeMapsAreEvaluatedAgainstTheDepthImages) {
   EXPECT_FALSE(fs::exists(out_no_depth / "keyframe_maps.csv"));
 }
 
+// odometry.bootstrap_passes: the passes re-run the first keyframe's frames (pass 1 is the plain
+// run's start, so it stops once the plain run's second keyframe has begun), the run proper starts
+// from the refined map and tracks every frame; combinations that make no sense are config errors.
+TEST(RunCommandTest, BootstrapRefinementRerunsTheFirstKeyframeFrames) {
+  // A keyframe at least every 8 frames keeps the passes short (CI budget).
+  const std::string kFramesFlag = " --max_frames 16 --set keyframes.max_frames=8";
+  const fs::path plain = TestRoot() / "run_bootstrap_plain";
+  ASSERT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " + plain.string() +
+                      kDeterministic + kFramesFlag,
+                  TestRoot() / "run_bootstrap_plain.log"),
+            0);
+  int second_keyframe = -1;
+  for (const std::vector<std::string>& row : CsvRows(plain / "timing.csv")) {
+    if (row[2] == "keyframe" && row[3] == "1") second_keyframe = std::stoi(row[0]);
+  }
+  ASSERT_GT(second_keyframe, 0);
+
+  const fs::path refined = TestRoot() / "run_bootstrap";
+  ASSERT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " + refined.string() +
+                      kDeterministic + kFramesFlag + " --set odometry.bootstrap_passes=3",
+                  TestRoot() / "run_bootstrap.log"),
+            0)
+      << Slurp(TestRoot() / "run_bootstrap.log");
+  const nlohmann::json summary = nlohmann::json::parse(Slurp(refined / "summary.json"));
+  const nlohmann::json& bootstrap = summary["bootstrap"];
+  ASSERT_TRUE(bootstrap.is_object()) << summary.dump();
+  ASSERT_EQ(bootstrap["frames"].size(), 2u);
+  ASSERT_EQ(bootstrap["points"].size(), 2u);
+  std::printf("second keyframe at frame %d; passes: frames %s, points %s\n", second_keyframe,
+              bootstrap["frames"].dump().c_str(), bootstrap["points"].dump().c_str());
+  // Pass 1 ends when the first keyframe's map is final: with or just after the second keyframe.
+  EXPECT_GE(bootstrap["frames"][0].get<int>(), second_keyframe + 1);
+  EXPECT_LE(bootstrap["frames"][0].get<int>(), second_keyframe + 2);
+  EXPECT_GT(bootstrap["frames"][1].get<int>(), 1);
+  for (const nlohmann::json& points : bootstrap["points"]) EXPECT_GT(points.get<int>(), 1000);
+  EXPECT_EQ(summary["tracked"].get<int>(), 16);
+  EXPECT_TRUE(nlohmann::json::parse(Slurp(plain / "summary.json"))["bootstrap"].is_null());
+
+  // One frame: the pass's map has no stereo observation, so the run starts from the random map
+  // and says so.
+  const fs::path one = TestRoot() / "run_bootstrap_one_frame";
+  ASSERT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " + one.string() +
+                      kDeterministic + " --max_frames 1 --set odometry.bootstrap_passes=2",
+                  TestRoot() / "run_bootstrap_one_frame.log"),
+            0)
+      << Slurp(TestRoot() / "run_bootstrap_one_frame.log");
+  EXPECT_NE(Slurp(TestRoot() / "run_bootstrap_one_frame.log").find("bootstrap refinement failed"),
+            std::string::npos)
+      << Slurp(TestRoot() / "run_bootstrap_one_frame.log");
+  EXPECT_TRUE(nlohmann::json::parse(Slurp(one / "summary.json"))["bootstrap"].is_null());
+
+  for (const std::string& bad :
+       {std::string(" --set odometry.bootstrap_passes=0"),
+        std::string(
+            " --set odometry.bootstrap_passes=2 --set odometry.init_depth_idepth_var=0.0001"),
+        std::string(" --set odometry.bootstrap_idepth_var=0")}) {
+    const fs::path log = TestRoot() / "run_bootstrap_bad.log";
+    EXPECT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " +
+                        (TestRoot() / "run_bootstrap_bad").string() + bad,
+                    log),
+              2)
+        << bad;
+    EXPECT_NE(Slurp(log).find("bootstrap_"), std::string::npos) << Slurp(log);
+  }
+}
+
 TEST(RunCommandTest, UnknownConfigKeyIsAnError) {
   // The config is checked before the dataset is opened: no dataset needed.
   const fs::path log = TestRoot() / "run_bad_key.log";

@@ -1,0 +1,82 @@
+#include "backend/bootstrap_refiner.h"
+
+#include <chrono>
+#include <stdexcept>
+#include <string>
+
+#include "backend/odometry.h"
+#include "backend/odometry_observer.h"
+#include "core/evaluation.h"
+
+namespace pldvo {
+namespace {
+
+// Keeps the first keyframe's final map as z-depth (observed hypotheses only, as the PLY export).
+class FirstKeyframeCapture : public OdometryObserver {
+ public:
+  bool WantsKeyframeMaps() const override { return true; }
+  void OnKeyframeFinished(const KeyframeInfo& keyframe, const SemiDenseDepthMap& map) override {
+    if (captured_ || keyframe.keyframe_id != 0) return;
+    captured_ = true;
+    depth_ = cv::Mat::zeros(map.height(), map.width(), CV_32F);
+    for (int i = 0; i < map.num_pixels(); ++i) {
+      if (!map.valid(i) || !(map.idepth(i) > 0.f) || map.num_observations(i) == 0) continue;
+      depth_.at<float>(i / map.width(), i % map.width()) = 1.f / map.idepth(i);
+      idepths_.push_back(map.idepth(i));
+    }
+  }
+  bool captured() const { return captured_; }
+  // The depth with the median inverse depth scaled to 1 (the scale is arbitrary).
+  cv::Mat NormalizedDepth() const { return depth_ * Median(idepths_); }
+  int points() const { return static_cast<int>(idepths_.size()); }
+
+ private:
+  bool captured_ = false;
+  cv::Mat depth_;
+  std::vector<double> idepths_;
+};
+
+}  // namespace
+
+BootstrapRefinement RefineBootstrap(const Dataset& dataset, const OdometryConfig& config,
+                                    int num_frames) {
+  if (config.odometry.bootstrap_passes < 2) {
+    throw std::invalid_argument("RefineBootstrap: odometry.bootstrap_passes must be >= 2");
+  }
+  const auto start = std::chrono::steady_clock::now();
+  OdometryConfig pass_config = config;
+  pass_config.backend.edge_ba.enabled = false;
+  pass_config.odometry.compare_solver = OdometryOptions::CompareSolver::kNone;
+  pass_config.odometry.bootstrap_passes = 1;  // a pass is a plain run
+  BootstrapRefinement refinement;
+  for (int pass = 1; pass < config.odometry.bootstrap_passes; ++pass) {
+    // Pass 1 starts from the random map, every later one from the previous pass's map.
+    pass_config.odometry.init_depth_idepth_var =
+        refinement.depth.empty() ? 0.0 : config.odometry.bootstrap_idepth_var;
+    FirstKeyframeCapture capture;
+    Odometry odometry(dataset.camera(), pass_config, &capture);
+    int frames = 0;
+    for (int i = 0; i < num_frames && !capture.captured(); ++i, ++frames) {
+      try {
+        const Frame frame = dataset.Load(i);
+        odometry.ProcessFrame(i, frame.timestamp, frame.image,
+                              i == 0 ? refinement.depth : cv::Mat());
+      } catch (const std::exception& e) {
+        odometry.SkipFrame(i, dataset.timestamp(i), e.what());
+      }
+    }
+    odometry.Finish();  // the first keyframe's map when the frames ended before a second one
+    if (!capture.captured() || capture.points() == 0) {
+      throw std::runtime_error("bootstrap refinement pass " + std::to_string(pass) +
+                               ": the first keyframe's map has no observed hypothesis");
+    }
+    refinement.depth = capture.NormalizedDepth();
+    refinement.frames.push_back(frames);
+    refinement.points.push_back(capture.points());
+  }
+  refinement.ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return refinement;
+}
+
+}  // namespace pldvo
