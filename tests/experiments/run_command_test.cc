@@ -218,8 +218,9 @@ TEST(RunCommandTest, KeyframeMapsAreEvaluatedAgainstTheDepthImages) {
 }
 
 // odometry.bootstrap_passes: the passes re-run the first keyframe's frames (pass 1 is the plain
-// run's start, so it stops once the plain run's second keyframe has begun), the run proper starts
-// from the refined map and tracks every frame; combinations that make no sense are config errors.
+// run's start, so it stops once the plain run's second keyframe has begun) and keep its map, the
+// run then tracks every frame; a failed pass falls back to the random map; combinations that make
+// no sense are config errors.
 TEST(RunCommandTest, BootstrapRefinementRerunsTheFirstKeyframeFrames) {
   // A keyframe at least every 8 frames keeps the passes short (CI budget).
   const std::string kFramesFlag = " --max_frames 16 --set keyframes.max_frames=8";
