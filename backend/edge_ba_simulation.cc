@@ -6,6 +6,8 @@
 #include <random>
 #include <stdexcept>
 
+#include "core/random_draws.h"
+
 namespace pldvo {
 namespace {
 
@@ -30,7 +32,7 @@ Eigen::Vector3d CameraCenter(const SE3& cam_from_world) {
 
 Eigen::Vector3d RandomVector(std::mt19937_64* rng, double sigma) {
   std::normal_distribution<double> normal(0.0, sigma);
-  return Eigen::Vector3d(normal(*rng), normal(*rng), normal(*rng));
+  return DrawVector3(normal, *rng);
 }
 
 double Rms(double sum_sq, int count) { return count > 0 ? std::sqrt(sum_sq / count) : 0.0; }
@@ -89,8 +91,7 @@ EdgeBASimulation SimulateEdgeBAWindow(const PinholeCamera& camera,
       const int n = options.pixels_per_observation;
       for (int j = 0; j < n; ++j) {
         const double s = static_cast<double>(j) / (n - 1);
-        observation.pixels.push_back(p_in + s * (q_in - p_in) +
-                                     Eigen::Vector2d(pixel_noise(rng), pixel_noise(rng)));
+        observation.pixels.push_back(p_in + s * (q_in - p_in) + DrawVector2(pixel_noise, rng));
       }
       keyframe.observations.push_back(std::move(observation));
     }
@@ -136,10 +137,11 @@ EdgeBAScene MakeRandomLineScene(int num_lines, int num_keyframes, double spacing
   std::uniform_real_distribution<double> length(0.5, 1.5);
   EdgeBAScene scene;
   for (int i = 0; i < num_lines; ++i) {
-    const Eigen::Vector3d midpoint(2.0 * unit(rng), 1.5 * unit(rng), 4.5 + 1.5 * unit(rng));
+    const Eigen::Vector3d u = DrawVector3(unit, rng);
+    const Eigen::Vector3d midpoint(2.0 * u.x(), 1.5 * u.y(), 4.5 + 1.5 * u.z());
     Eigen::Vector3d direction;
     do {
-      direction = Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
+      direction = DrawVector3(unit, rng);
     } while (direction.norm() > 1.0 || direction.norm() < 0.1);  // uniform on the sphere
     direction.normalize();
     const double half = 0.5 * length(rng);
@@ -148,10 +150,10 @@ EdgeBAScene MakeRandomLineScene(int num_lines, int num_keyframes, double spacing
   }
   const double max_angle = 2.0 * M_PI / 180.0;
   for (int k = 0; k < num_keyframes; ++k) {
-    const Eigen::Vector3d center(spacing_m * (k - 0.5 * (num_keyframes - 1)) + 0.02 * unit(rng),
-                                 0.02 * unit(rng), 0.02 * unit(rng));
-    const Eigen::Vector3d rotation(max_angle * unit(rng), max_angle * unit(rng),
-                                   max_angle * unit(rng));
+    const Eigen::Vector3d center =
+        Eigen::Vector3d(spacing_m * (k - 0.5 * (num_keyframes - 1)), 0.0, 0.0) +
+        0.02 * DrawVector3(unit, rng);
+    const Eigen::Vector3d rotation = max_angle * DrawVector3(unit, rng);
     scene.world_from_cam.push_back(SE3(ExpSO3(rotation), center));
   }
   return scene;

@@ -7,6 +7,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "core/random_draws.h"
 #include "frontend/line_segment.h"
 #include "residuals/covariance_models.h"
 
@@ -142,8 +143,8 @@ std::vector<MatchedLine> ProjectGroundTruthLines(const GroundTruthEdges& edges,
     }
     if ((q - p).norm() < 10.0) continue;
     if (sigma_px > 0.0) {
-      p += Eigen::Vector2d(noise(rng), noise(rng));
-      q += Eigen::Vector2d(noise(rng), noise(rng));
+      p += DrawVector2(noise, rng);
+      q += DrawVector2(noise, rng);
     }
     lines[line.id].matched = true;
     lines[line.id].line_in_cur = FitLine(p, q, std::max(sigma_px, 1e-3));

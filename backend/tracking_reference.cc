@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "core/image_pyramid.h"
+#include "core/random_draws.h"
 
 namespace pldvo {
 namespace {
@@ -199,8 +200,8 @@ int AddGroundTruthEdges(const cv::Mat& image, const cv::Mat& depth,
                       &p1, &p2) &&
           (p2 - p1).norm() >= kMinMatchedLength) {
         if (options.line_noise_px > 0.0) {
-          p1 += options.line_noise_px * Eigen::Vector2d(gaussian(rng), gaussian(rng));
-          p2 += options.line_noise_px * Eigen::Vector2d(gaussian(rng), gaussian(rng));
+          p1 += options.line_noise_px * DrawVector2(gaussian, rng);
+          p2 += options.line_noise_px * DrawVector2(gaussian, rng);
         }
         matched_level0.matched = true;
         matched_level0.line_in_cur = FitLine(p1, p2, options.line_sigma_px);

@@ -47,7 +47,8 @@ struct Scene {
         v(40.0, camera.height - 40.0), idepth(0.2, 1.0), angle(0.0, 6.28);
     for (int i = 0; i < kBatch; ++i) {
       PhotometricObservation o;
-      o.pixel_in_ref = Eigen::Vector2d(u(rng), v(rng));
+      const double y = v(rng), x = u(rng);  // core/random_draws.h
+      o.pixel_in_ref = Eigen::Vector2d(x, y);
       o.idepth = idepth(rng);
       o.intensity_ref = 128.0;
       o.sqrt_info = 0.2;

@@ -12,6 +12,7 @@
 #include <set>
 #include <vector>
 
+#include "core/random_draws.h"
 #include "frontend/line_segment.h"
 
 namespace pldvo {
@@ -79,8 +80,10 @@ TEST(LineRegularizerTest, RecoversKnownLinesAndRejectsOutliers) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   int tested = 0;
   for (int trial = 0; trial < 20; ++trial) {
-    const Eigen::Vector3d a(u(rng), 0.6 * u(rng), 2.5 + u(rng));
-    const Eigen::Vector3d b(u(rng), 0.6 * u(rng), 2.5 + u(rng));
+    const Eigen::Vector3d ra = DrawVector3(u, rng);
+    const Eigen::Vector3d a(ra.x(), 0.6 * ra.y(), 2.5 + ra.z());
+    const Eigen::Vector3d rb = DrawVector3(u, rng);
+    const Eigen::Vector3d b(rb.x(), 0.6 * rb.y(), 2.5 + rb.z());
     const Eigen::Vector2d pa = camera.Project(a), pb = camera.Project(b);
     if ((pb - pa).norm() < 60.0 || !camera.IsInside(pa, 2) || !camera.IsInside(pb, 2)) continue;
     ++tested;

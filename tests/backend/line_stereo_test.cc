@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "core/random_draws.h"
 #include "residuals/covariance_models.h"
 
 namespace pldvo {
@@ -33,7 +34,8 @@ TEST(LineStereoTest, PlaneIntersectionIsExactOnNoiselessGeometry) {
     const SE3 cur_from_ref = SE3::Exp((Vector6d() << 0.3 * u(rng), 0.3 * u(rng), 0.3 * u(rng),
                                        0.1 * u(rng), 0.1 * u(rng), 0.1 * u(rng))
                                           .finished());
-    const Eigen::Vector3d a(u(rng), u(rng), 3.0 + u(rng)), b(u(rng), u(rng), 3.0 + u(rng));
+    const Eigen::Vector3d ra = DrawVector3(u, rng), rb = DrawVector3(u, rng);
+    const Eigen::Vector3d a(ra.x(), ra.y(), 3.0 + ra.z()), b(rb.x(), rb.y(), 3.0 + rb.z());
     if ((cur_from_ref * a).z() < 0.5 || (cur_from_ref * b).z() < 0.5) continue;
     const Eigen::Vector3d l1 = ProjectLine(camera, a, b);
     const Eigen::Vector3d l2 = ProjectLine(camera, cur_from_ref * a, cur_from_ref * b);
@@ -101,8 +103,8 @@ TEST(LineStereoTest, DisparityVarianceMatchesMonteCarlo) {
     std::normal_distribution<double> noise(0.0, 1.0);
     double sum = 0.0, sum_sq = 0.0;
     for (int k = 0; k < kSamples; ++k) {
-      const Eigen::Vector2d q1 = p1 + sigma_px * Eigen::Vector2d(noise(rng), noise(rng));
-      const Eigen::Vector2d q2 = p2 + sigma_px * Eigen::Vector2d(noise(rng), noise(rng));
+      const Eigen::Vector2d q1 = p1 + sigma_px * DrawVector2(noise, rng);
+      const Eigen::Vector2d q2 = p2 + sigma_px * DrawVector2(noise, rng);
       const double offset = sigma_g * noise(rng);
       // Intersection of y = offset with the line through q1, q2.
       const double s = (offset - q1.y()) / (q2.y() - q1.y());
@@ -141,8 +143,8 @@ TEST(LineStereoTest, IdepthVarianceMatchesMonteCarlo) {
   double sum = 0.0, sum_sq = 0.0;
   int n = 0;
   for (int k = 0; k < kSamples; ++k) {
-    const Eigen::Vector2d q1 = c1 + Eigen::Vector2d(noise(rng), noise(rng));
-    const Eigen::Vector2d q2 = c2 + Eigen::Vector2d(noise(rng), noise(rng));
+    const Eigen::Vector2d q1 = c1 + DrawVector2(noise, rng);
+    const Eigen::Vector2d q2 = c2 + DrawVector2(noise, rng);
     StereoObservation observation;
     if (LineGuidedStereo(geometry, pixel, pixel, FitLine(q1, q2, sigma_px), 0.0, 5.0, options,
                          nullptr, nullptr, &observation) != StereoStatus::kOk) {

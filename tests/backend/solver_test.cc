@@ -13,6 +13,7 @@
 #include "backend/ceres_solver.h"
 #include "backend/gauss_newton_solver.h"
 #include "backend/least_squares_problem.h"
+#include "core/random_draws.h"
 #include "residuals/se3_manifold.h"
 
 namespace pldvo {
@@ -123,10 +124,11 @@ PoseProblemData MakePoseData(int num_points, int num_outliers, unsigned seed) {
   twist << 0.3, -0.2, 0.1, 0.2, -0.3, 0.25;
   data.cur_from_ref = SE3::Exp(twist);
   for (int i = 0; i < num_points; ++i) {
-    const Eigen::Vector3d p(uniform(rng), uniform(rng), 3.0 + uniform(rng));
+    const Eigen::Vector3d r = DrawVector3(uniform, rng);
+    const Eigen::Vector3d p(r.x(), r.y(), 3.0 + r.z());
     data.points_in_ref.push_back(p);
-    Eigen::Vector3d q = data.cur_from_ref * p + Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
-    if (i < num_outliers) q += Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng));
+    Eigen::Vector3d q = data.cur_from_ref * p + DrawVector3(noise, rng);
+    if (i < num_outliers) q += DrawVector3(uniform, rng);
     data.points_in_cur.push_back(q);
   }
   return data;

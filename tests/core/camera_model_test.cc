@@ -53,7 +53,8 @@ std::vector<Eigen::Vector3d> PointsInView(const CameraModel& camera, int count, 
       depth_dist(0.5, 8.0);
   std::vector<Eigen::Vector3d> points;
   while (static_cast<int>(points.size()) < count) {
-    const Eigen::Vector3d ray = camera.Unproject(Eigen::Vector2d(u_dist(rng), v_dist(rng)));
+    const double v = v_dist(rng), u = u_dist(rng);  // core/random_draws.h
+    const Eigen::Vector3d ray = camera.Unproject(Eigen::Vector2d(u, v));
     if (ray.allFinite()) points.push_back(depth_dist(rng) * ray);
   }
   return points;

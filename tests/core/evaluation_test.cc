@@ -5,6 +5,8 @@
 #include <cmath>
 #include <random>
 
+#include "core/random_draws.h"
+
 namespace pldvo {
 namespace {
 
@@ -52,7 +54,7 @@ TEST(AlignUmeyama, RecoversAKnownSimilarity) {
       Eigen::AngleAxisd(2.0, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
   const Eigen::Vector3d translation(3, -1, 7);
   for (int i = 0; i < 20; ++i) {
-    src.emplace_back(normal(rng), normal(rng), normal(rng));
+    src.push_back(DrawVector3(normal, rng));
     dst.push_back(0.3 * rotation * src.back() + translation);
   }
   const Sim3Alignment alignment = AlignUmeyama(src, dst);

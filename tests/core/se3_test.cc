@@ -5,6 +5,8 @@
 #include <cmath>
 #include <random>
 
+#include "core/random_draws.h"
+
 namespace pldvo {
 namespace {
 
@@ -15,7 +17,7 @@ constexpr double kNumericTolerance = 1e-8;
 
 Eigen::Vector3d RandomAxis(std::mt19937& rng) {
   std::normal_distribution<double> normal;
-  return Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+  return DrawVector3(normal, rng).normalized();
 }
 
 TEST(SO3, ExpMatchesAngleAxisAcrossAngles) {

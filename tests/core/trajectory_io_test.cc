@@ -9,6 +9,8 @@
 #include <random>
 #include <sstream>
 
+#include "core/random_draws.h"
+
 namespace pldvo {
 namespace {
 
@@ -50,9 +52,9 @@ TEST_F(TrajectoryIoTest, WriteThenReadIsExact) {
   for (int i = 0; i < 50; ++i) {
     StampedPose pose;
     pose.timestamp = 1305031102.175304 + 0.0333 * i;  // TUM-like absolute times
-    pose.world_from_cam =
-        SE3(Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized(),
-            Eigen::Vector3d(normal(rng), normal(rng), normal(rng)));
+    const Eigen::Vector3d t = DrawVector3(normal, rng);
+    const double qz = normal(rng), qy = normal(rng), qx = normal(rng), qw = normal(rng);
+    pose.world_from_cam = SE3(Eigen::Quaterniond(qw, qx, qy, qz).normalized(), t);
     trajectory.push_back(pose);
   }
   const std::string path = (dir_ / "traj.txt").string();

@@ -22,7 +22,8 @@ TEST(EdgeTracer, PixelsNearSegmentsAndMapConsistent) {
   std::uniform_real_distribution<double> x(-20.0, 660.0), y(-20.0, 500.0);
   std::vector<LineSegment> segments;
   while (segments.size() < 60) {
-    const Eigen::Vector2d a(x(rng), y(rng)), b(x(rng), y(rng));
+    const double ay = y(rng), ax = x(rng), by = y(rng), bx = x(rng);  // core/random_draws.h
+    const Eigen::Vector2d a(ax, ay), b(bx, by);
     if ((a - b).norm() > 5.0) segments.push_back(MakeLineSegment(a, b, 0, 0.5));
   }
   std::vector<int> ids;

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <random>
 
+#include "core/random_draws.h"
+
 namespace pldvo {
 namespace {
 
@@ -90,7 +92,8 @@ TEST(LineMerger, ManyRandomFragmentsOfFewLines) {
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   std::vector<LineSegment> pieces;
   for (int line = 0; line < 12; ++line) {
-    const Eigen::Vector2d origin(50 + 540 * uniform(rng), 50 + 380 * uniform(rng));
+    const Eigen::Vector2d u = DrawVector2(uniform, rng);
+    const Eigen::Vector2d origin(50 + 540 * u.x(), 50 + 380 * u.y());
     const double angle = 2 * M_PI * uniform(rng);
     const Eigen::Vector2d d(std::cos(angle), std::sin(angle));
     const Eigen::Vector2d n(-d.y(), d.x());

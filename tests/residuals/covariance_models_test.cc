@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "core/random_draws.h"
 #include "residuals/photometric_residual.h"
 #include "residuals/se3_manifold.h"
 #include "tests/residuals/residual_test_utils.h"
@@ -70,8 +71,8 @@ TEST(FitLine, CovarianceMatchesMonteCarlo) {
   std::vector<Eigen::Vector3d> lines;
   lines.reserve(kSamples);
   for (int k = 0; k < kSamples; ++k) {
-    const Eigen::Vector2d q1 = p1 + Eigen::Vector2d(noise(rng), noise(rng));
-    const Eigen::Vector2d q2 = p2 + Eigen::Vector2d(noise(rng), noise(rng));
+    const Eigen::Vector2d q1 = p1 + DrawVector2(noise, rng);
+    const Eigen::Vector2d q2 = p2 + DrawVector2(noise, rng);
     lines.push_back(FitLine(q1, q2, 0.0).line);  // the real cross product + normalisation
   }
   const Eigen::Matrix3d measured = SampleCovariance<3>(lines);
@@ -316,8 +317,8 @@ TEST(PointToLineVariance, MatchesMonteCarlo) {
   std::normal_distribution<double> unit(0.0, 1.0);
   std::vector<double> distances;
   for (int k = 0; k < kSamples; ++k) {
-    const Eigen::Vector2d q1 = p1 + kSigmaPx * Eigen::Vector2d(unit(rng), unit(rng));
-    const Eigen::Vector2d q2 = p2 + kSigmaPx * Eigen::Vector2d(unit(rng), unit(rng));
+    const Eigen::Vector2d q1 = p1 + kSigmaPx * DrawVector2(unit, rng);
+    const Eigen::Vector2d q2 = p2 + kSigmaPx * DrawVector2(unit, rng);
     const Eigen::Vector3d l = FitLine(q1, q2, 0.0).line;
     Eigen::Vector2d pixel;
     ASSERT_TRUE(

@@ -123,7 +123,8 @@ class PhotometricResidualTest : public ::testing::Test {
     std::uniform_real_distribution<double> sqrt_info_dist(0.3, 0.6);
     std::vector<PhotometricObservation> observations;
     for (int i = 0; i < count; ++i) {
-      Eigen::Vector2d pixel_in_cur(u_dist(rng), v_dist(rng));
+      const double v = v_dist(rng), u = u_dist(rng);  // core/random_draws.h
+      Eigen::Vector2d pixel_in_cur(u, v);
       if (placement == Placement::kCellCentres) pixel_in_cur = pixel_in_cur.array().floor() + 0.5;
       if (placement == Placement::kCellCorners) pixel_in_cur = pixel_in_cur.array().round();
       PhotometricObservation o;

@@ -83,7 +83,8 @@ class PointToLineResidualTest : public ::testing::Test {
     std::uniform_real_distribution<double> sqrt_info_dist(0.6, 1.0);
     std::vector<PointToLineObservation> observations;
     for (int i = 0; i < count; ++i) {
-      const Eigen::Vector2d pixel_in_cur(u_dist(rng), v_dist(rng));
+      const double v = v_dist(rng), u = u_dist(rng);  // core/random_draws.h
+      const Eigen::Vector2d pixel_in_cur(u, v);
       PointToLineObservation o;
       PlaceReferencePixel(camera_, cur_from_ref_, pixel_in_cur, depth_dist(rng), &o.pixel_in_ref,
                           &o.idepth);

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/random_draws.h"
 #include "tests/residuals/residual_test_utils.h"
 
 namespace pldvo {
@@ -168,8 +169,8 @@ TEST(Weighting, SharedLineErrorWhitensTheRowsOfAnEdge) {
   Eigen::MatrixXd per_pixel_cov = Eigen::MatrixXd::Zero(kPixels, kPixels);
   Eigen::VectorXd g(kPixels);
   for (int k = 0; k < kSamples; ++k) {
-    const Eigen::Vector2d q1 = p1 + kSigma * Eigen::Vector2d(normal(rng), normal(rng));
-    const Eigen::Vector2d q2 = p2 + kSigma * Eigen::Vector2d(normal(rng), normal(rng));
+    const Eigen::Vector2d q1 = p1 + kSigma * DrawVector2(normal, rng);
+    const Eigen::Vector2d q2 = p2 + kSigma * DrawVector2(normal, rng);
     const Eigen::Vector3d detected = FitLine(q1, q2, kSigma).line;
     // FitLine's sign convention follows the endpoint order, which the noise does not flip here.
     for (int j = 0; j < kPixels; ++j) {
