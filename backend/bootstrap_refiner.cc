@@ -20,7 +20,7 @@ class FirstKeyframeCapture : public OdometryObserver {
     captured_ = true;
     depth_ = cv::Mat::zeros(map.height(), map.width(), CV_32F);
     for (int i = 0; i < map.num_pixels(); ++i) {
-      if (!map.valid(i) || !(map.idepth(i) > 0.f) || map.num_observations(i) == 0) continue;
+      if (!map.observed(i)) continue;
       depth_.at<float>(i / map.width(), i % map.width()) = 1.f / map.idepth(i);
       idepths_.push_back(map.idepth(i));
     }
@@ -55,8 +55,8 @@ BootstrapRefinement RefineBootstrap(const Dataset& dataset, const OdometryConfig
         refinement.depth.empty() ? 0.0 : config.odometry.bootstrap_idepth_var;
     FirstKeyframeCapture capture;
     Odometry odometry(dataset.camera(), pass_config, &capture);
-    int frames = 0;
-    for (int i = 0; i < num_frames && !capture.captured(); ++i, ++frames) {
+    int i = 0;  // after the loop: the frames processed
+    for (; i < num_frames && !capture.captured(); ++i) {
       try {
         const Frame frame = dataset.Load(i);
         odometry.ProcessFrame(i, frame.timestamp, frame.image,
@@ -71,7 +71,7 @@ BootstrapRefinement RefineBootstrap(const Dataset& dataset, const OdometryConfig
                                ": the first keyframe's map has no observed hypothesis");
     }
     refinement.depth = capture.NormalizedDepth();
-    refinement.frames.push_back(frames);
+    refinement.frames.push_back(i);
     refinement.points.push_back(capture.points());
   }
   refinement.ms =

@@ -9,13 +9,6 @@
 #include <vector>
 
 namespace pldvo {
-namespace {
-
-bool Writable(const SemiDenseDepthMap& map, int i) {
-  return map.valid(i) && map.idepth(i) > 0.f && map.num_observations(i) > 0;
-}
-
-}  // namespace
 
 cv::Mat ColorizeInverseDepth(const SemiDenseDepthMap& map, double idepth_min, double idepth_max) {
   if (!(idepth_max > idepth_min)) {
@@ -72,7 +65,7 @@ int WritePointCloudPly(const SemiDenseDepthMap& map, const cv::Mat& image,
   cv::Mat intensity;
   image.convertTo(intensity, CV_32F);
   int count = 0;
-  for (int i = 0; i < map.num_pixels(); ++i) count += Writable(map, i);
+  for (int i = 0; i < map.num_pixels(); ++i) count += map.observed(i);
   std::ofstream out(path);
   if (!out) throw std::runtime_error("WritePointCloudPly: cannot open " + path);
   out << "ply\nformat ascii 1.0\ncomment pldvo semi-dense keyframe map (world frame, metres)\n"
@@ -82,7 +75,7 @@ int WritePointCloudPly(const SemiDenseDepthMap& map, const cv::Mat& image,
   for (int y = 0; y < map.height(); ++y) {
     for (int x = 0; x < map.width(); ++x) {
       const int i = map.Index(x, y);
-      if (!Writable(map, i)) continue;
+      if (!map.observed(i)) continue;
       const Eigen::Vector3d point_in_cam = camera.Unproject(Eigen::Vector2d(x, y)) / map.idepth(i);
       const Eigen::Vector3d point_in_world = world_from_cam * point_in_cam;
       std::snprintf(line, sizeof(line), "%.6g %.6g %.6g %.1f\n", point_in_world.x(),

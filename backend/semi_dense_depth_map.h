@@ -53,6 +53,9 @@ class SemiDenseDepthMap {
   int validity(int i) const { return validity_[i]; }
   int blacklist(int i) const { return blacklist_[i]; }
   int num_observations(int i) const { return num_observations_[i]; }
+  // A valid hypothesis with a positive inverse depth and at least one observation (hole-filled
+  // guesses excluded): what the PLY export and the bootstrap refinement keep.
+  bool observed(int i) const { return valid_[i] && idepth_[i] > 0.f && num_observations_[i] > 0; }
   // B of Fuse: the standard deviation of the hypothesis' error component that is shared with
   // the pixel's future stereo observations, 1/m; B^2 <= V.
   float idepth_shared_sd(int i) const { return idepth_shared_sd_[i]; }
