@@ -2,7 +2,9 @@
 # Builds the whole test suite with AddressSanitizer + UndefinedBehaviorSanitizer (LeakSanitizer
 # included) into ${PLDVO_ASAN_BUILD_DIR:-build-asan} and runs every test; any sanitizer report
 # fails its test. Usage: scripts/sanitize.sh [ctest args...]   (e.g. -R Trajectory)
-# ${PLDVO_ASAN_FLAGS:--O1 -g1} are the compile flags (.ci/run passes -O1 -g0). Prints the build
+# ${PLDVO_ASAN_FLAGS:--O1 -g1} are the compile flags (.ci/run passes -O1 -g0) and
+# ${PLDVO_ASAN_CXX:-clang++} the compiler (clang builds the suite ~35% faster than g++, and the
+# fuzzers need it anyway; PLDVO_ASAN_CXX=g++ gives gcc's sanitizers). Prints the build
 # and test wall times. ${PLDVO_ASAN_STACK_USE_AFTER_RETURN:-1}: ASan's detect_stack_use_after_return
 # (.ci/run passes 0). See docs/reliability.md.
 set -euo pipefail
@@ -15,6 +17,7 @@ build=${PLDVO_ASAN_BUILD_DIR:-build-asan}
 # checked here too. The tests see PLDVO_SANITIZE defined (tests/CMakeLists.txt).
 start=$SECONDS
 cmake -S . -B "$build" -G Ninja \
+  -DCMAKE_CXX_COMPILER="${PLDVO_ASAN_CXX:-clang++}" \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="${PLDVO_ASAN_FLAGS:--O1 -g1}" \
   -DPLDVO_SANITIZE=ON -DPLDVO_BUILD_TESTS=ON -DPLDVO_BUILD_BENCHMARKS=OFF \

@@ -200,8 +200,10 @@ void AddTable(SceneBuilder* b, double floor_albedo) {
   const double yaw = rng.Uniform(-0.5, 0.5);
   const double length = rng.Uniform(1.1, 1.5), width = rng.Uniform(0.7, 0.85);
   const double height = rng.Uniform(0.72, 0.76), top = 0.04, leg = 0.05;
-  const Eigen::Vector2d center(0.5 * room.x() + rng.Uniform(-0.4, 0.4),
-                               0.5 * room.y() + rng.Uniform(-0.4, 0.4));
+  // Several draws feeding one call are made first, last argument first (core/random_draws.h).
+  const double center_dy = rng.Uniform(-0.4, 0.4);
+  const double center_dx = rng.Uniform(-0.4, 0.4);
+  const Eigen::Vector2d center(0.5 * room.x() + center_dx, 0.5 * room.y() + center_dy);
   const Eigen::Matrix2d world_from_table = Eigen::Rotation2Dd(yaw).toRotationMatrix();
   const double albedo = b->AlbedoAwayFrom(floor_albedo, 0.2, 0.85, 0.2);
   b->Box(Eigen::Vector3d(center.x(), center.y(), height - 0.5 * top),
@@ -218,11 +220,14 @@ void AddTable(SceneBuilder* b, double floor_albedo) {
   }
   // A box lying on the table at its own yaw.
   const double bx = rng.Uniform(0.2, 0.4), by = rng.Uniform(0.15, 0.3), bz = rng.Uniform(0.1, 0.25);
-  const Eigen::Vector2d offset(rng.Uniform(-0.25, 0.25) * length, rng.Uniform(-0.2, 0.2) * width);
-  const Eigen::Vector2d p = center + world_from_table * offset;
+  const double offset_y = rng.Uniform(-0.2, 0.2) * width;
+  const double offset_x = rng.Uniform(-0.25, 0.25) * length;
+  const Eigen::Vector2d p = center + world_from_table * Eigen::Vector2d(offset_x, offset_y);
+  const double box_albedo = b->AlbedoAwayFrom(albedo, 0.1, 0.9, 0.2);
+  const double box_yaw = yaw + rng.Uniform(-0.8, 0.8);
   b->Box(Eigen::Vector3d(p.x(), p.y(), height + 0.5 * bz),
-         Eigen::Vector3d(0.5 * bx, 0.5 * by, 0.5 * bz), yaw + rng.Uniform(-0.8, 0.8),
-         b->AlbedoAwayFrom(albedo, 0.1, 0.9, 0.2), Pattern::kNoise, 0.04, "box_on_table");
+         Eigen::Vector3d(0.5 * bx, 0.5 * by, 0.5 * bz), box_yaw, box_albedo, Pattern::kNoise, 0.04,
+         "box_on_table");
 }
 
 // Fills the four walls with doors, cabinets, shelves, gaps and pictures.
@@ -331,11 +336,16 @@ void Scene::AddPrimitive(const Primitive& primitive) {
 Scene Scene::Generate(uint64_t seed) {
   Scene scene;
   Rng rng(seed * 0x2545F4914F6CDD1Dull + 17);
-  scene.SetRoom(
-      Eigen::Vector3d(rng.Uniform(4.5, 6.5), rng.Uniform(4.5, 7.0), rng.Uniform(2.5, 3.0)));
+  // Several draws feeding one call are made first, last argument first (core/random_draws.h).
+  const double room_z = rng.Uniform(2.5, 3.0);
+  const double room_y = rng.Uniform(4.5, 7.0);
+  const double room_x = rng.Uniform(4.5, 6.5);
+  scene.SetRoom(Eigen::Vector3d(room_x, room_y, room_z));
   const Eigen::Vector3d& room = scene.room_size();
-  scene.SetLight(Eigen::Vector3d(0.5 * room.x() + rng.Uniform(-0.5, 0.5),
-                                 0.5 * room.y() + rng.Uniform(-0.5, 0.5), room.z() - 0.5));
+  const double light_dy = rng.Uniform(-0.5, 0.5);
+  const double light_dx = rng.Uniform(-0.5, 0.5);
+  scene.SetLight(
+      Eigen::Vector3d(0.5 * room.x() + light_dx, 0.5 * room.y() + light_dy, room.z() - 0.5));
 
   // The room: walls of one paint (faces 0..3), floor (4), ceiling (5).
   Primitive interior;

@@ -67,16 +67,20 @@ CameraPath DrawPath(const Scene& scene, const SynthOptions& options, double ampl
                     Rng* rng) {
   const Eigen::Vector3d& room = scene.room_size();
   CameraPath path;
-  path.center = Eigen::Vector3d(0.5 * room.x() + rng->Uniform(-0.3, 0.3),
-                                0.5 * room.y() + rng->Uniform(-0.3, 0.3), rng->Uniform(1.4, 1.65));
+  // Several draws feeding one call are made first, last argument first (core/random_draws.h).
+  const double center_z = rng->Uniform(1.4, 1.65);
+  const double center_dy = rng->Uniform(-0.3, 0.3);
+  const double center_dx = rng->Uniform(-0.3, 0.3);
+  path.center = Eigen::Vector3d(0.5 * room.x() + center_dx, 0.5 * room.y() + center_dy, center_z);
   // Furniture reaches 0.65 m from a wall; the path keeps about 1.2 m from the walls.
   const double budget[3] = {std::max(0.1, 0.5 * room.x() - 1.2) * amplitude_scale,
                             std::max(0.1, 0.5 * room.y() - 1.2) * amplitude_scale, 0.15};
   for (int a = 0; a < 3; ++a) {
     DrawTerms(rng, budget[a], path.amp[a], path.freq[a], path.phase[a]);
   }
-  path.angle_offset =
-      Eigen::Vector3d(rng->Uniform(0.0, 2.0 * M_PI), rng->Uniform(-0.4, -0.15), 0.0);
+  const double base_pitch = rng->Uniform(-0.4, -0.15);
+  const double base_yaw = rng->Uniform(0.0, 2.0 * M_PI);
+  path.angle_offset = Eigen::Vector3d(base_yaw, base_pitch, 0.0);
   const double angle_budget[3] = {rng->Uniform(0.6, 1.3), 0.2, 0.07};  // radians
   for (int a = 0; a < 3; ++a) {
     DrawTerms(rng, angle_budget[a], path.angle_amp[a], path.angle_freq[a], path.angle_phase[a]);
