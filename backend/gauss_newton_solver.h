@@ -17,7 +17,9 @@
 // Tangent-space Jacobians are the cost functions' ambient Jacobians times
 // Manifold::PlusJacobian(x). The normal equations are dense (intended for small problems such
 // as a 6-DOF pose); accumulation uses buffers sized once per solve, no per-residual allocation.
-// Step acceptance and stopping: see SolverOptions.
+// Step acceptance and stopping: see SolverOptions. A trial step after an accepted one is
+// linearised in full, so a run of accepted steps evaluates the cost functions once per step
+// (Ceres' LM: twice, cost then Jacobians); after a rejection only the cost is evaluated.
 #ifndef PLDVO_BACKEND_GAUSS_NEWTON_SOLVER_H_
 #define PLDVO_BACKEND_GAUSS_NEWTON_SOLVER_H_
 

@@ -226,6 +226,67 @@ TEST(SolverTest, GaussNewtonCostNeverIncreasesAndCallbackSeesEveryIteration) {
   EXPECT_DOUBLE_EQ(cost, summary.final_cost);
 }
 
+// ExponentialResidual that counts its evaluations with and without Jacobians.
+class CountingExponentialResidual : public ExponentialResidual {
+ public:
+  CountingExponentialResidual(double x, double y, int* with_jacobians, int* cost_only)
+      : ExponentialResidual(x, y), with_jacobians_(with_jacobians), cost_only_(cost_only) {}
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    ++*(jacobians != nullptr ? with_jacobians_ : cost_only_);
+    return ExponentialResidual::Evaluate(parameters, residuals, jacobians);
+  }
+
+ private:
+  int* with_jacobians_;
+  int* cost_only_;
+};
+
+TEST(SolverTest, GaussNewtonLinearisesATrialAfterAnAcceptedStepOnce) {
+  // Start far from the minimum so that the solve has a run of accepted steps and rejections.
+  double mc[2] = {3.0, -2.0};
+  int with_jacobians = 0;
+  int cost_only = 0;
+  LeastSquaresProblem problem;
+  problem.AddParameterBlock(mc, 2);
+  constexpr int kBlocks = 20;
+  for (int i = 0; i < kBlocks; ++i) {
+    const double x = i / static_cast<double>(kBlocks);
+    problem.AddResidualBlock(
+        std::make_unique<CountingExponentialResidual>(
+            x, std::exp(0.3 * x + 0.1) + 0.01 * std::sin(7.0 * i), &with_jacobians, &cost_only),
+        nullptr, {mc});
+  }
+  std::vector<bool> accepted;
+  const SolverSummary summary = GaussNewtonSolver(TightOptions(SolverOptions::Type::kGaussNewton))
+                                    .Solve(&problem, [&](const SolverIteration& it) {
+                                      if (it.iteration > 0) accepted.push_back(it.step_accepted);
+                                    });
+  ASSERT_TRUE(summary.converged) << summary.message;
+  // The rule: the initial point and every trial after an accepted step (or the start) are
+  // linearised; a trial after a rejection is only costed, and linearised once if accepted.
+  int expected_jacobians = 1;
+  int expected_cost_only = 0;
+  int num_accepted = 0;
+  bool after_acceptance = true;
+  for (const bool a : accepted) {
+    if (after_acceptance) {
+      ++expected_jacobians;
+    } else {
+      ++expected_cost_only;
+      if (a) ++expected_jacobians;
+    }
+    after_acceptance = a;
+    num_accepted += a;
+  }
+  ASSERT_GE(num_accepted, 3);
+  EXPECT_EQ(with_jacobians, kBlocks * expected_jacobians);
+  EXPECT_EQ(cost_only, kBlocks * expected_cost_only);
+  // Fewer evaluations than costing every trial and relinearising every accepted one.
+  const int separate = kBlocks * (1 + num_accepted + static_cast<int>(accepted.size()));
+  EXPECT_LT(with_jacobians + cost_only, separate);
+}
+
 TEST(SolverTest, ConstantBlockIsNotMoved) {
   double mc[2] = {0.1, 0.2};
   LeastSquaresProblem problem;
