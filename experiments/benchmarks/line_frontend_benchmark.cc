@@ -6,6 +6,10 @@
 //   Describe                  LBD of the merged default lines
 //   Match                     frame 0 -> frame 5 bucketed matching (no predictor)
 //   Process/<lsd|edlines>     the whole per-frame pipeline (detect + merge + describe)
+//   Textured/<variant>        the whole pipeline on a `textured` frame (seed 3, frame 0; the
+//                             costliest frames of Table III), with the detect / merge /
+//                             describe milliseconds as counters: the defaults and the options
+//                             that trade lines for time (docs/line_frontend.md)
 // and, when /work/shared/data/kitti00_first200 exists (skipped otherwise), the whole frontend
 // over its 200 frames (1241x376): Kitti/<lsd|edlines> processes one frame per iteration and
 // matches it to the previous one; counters report lines (edges) per frame, detections per
@@ -17,6 +21,7 @@
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/synthetic/synthetic_sequence.h"
@@ -127,6 +132,39 @@ void BM_Process(benchmark::State& state, LineDetectorOptions::Method method) {
   state.counters["lines"] = static_cast<double>(num_lines);
 }
 
+const cv::Mat& TexturedFrame() {
+  static const cv::Mat image = [] {
+    synthetic::SynthOptions options;
+    options.preset = "textured";
+    options.frames = 1;
+    options.seed = 3;
+    return synthetic::RenderFrame(synthetic::MakeSequence(options), 0).image;
+  }();
+  return image;
+}
+
+void BM_Textured(benchmark::State& state, LineFrontendOptions options) {
+  const cv::Mat& image = TexturedFrame();
+  LineFrontend frontend(options);
+  LineFrontendTiming sum;
+  int64_t num_frames = 0;
+  for (auto _ : state) {
+    const LineFrame frame = frontend.Process(image);
+    sum.detection_ms += frame.timing.detection_ms;
+    sum.merging_ms += frame.timing.merging_ms;
+    sum.description_ms += frame.timing.description_ms;
+    sum.num_detected = frame.timing.num_detected;
+    sum.num_lines = frame.timing.num_lines;
+    ++num_frames;
+  }
+  const double n = static_cast<double>(std::max<int64_t>(1, num_frames));
+  state.counters["detected"] = sum.num_detected;
+  state.counters["lines"] = sum.num_lines;
+  state.counters["detect_ms"] = sum.detection_ms / n;
+  state.counters["merge_ms"] = sum.merging_ms / n;
+  state.counters["describe_ms"] = sum.description_ms / n;
+}
+
 // The KITTI frames in file-name order, 8-bit gray; empty when the folder is missing.
 const std::vector<cv::Mat>& KittiFrames() {
   static const std::vector<cv::Mat> frames = [] {
@@ -196,6 +234,20 @@ void RegisterAll() {
       ->Unit(benchmark::kMillisecond);
   benchmark::RegisterBenchmark("Process/edlines", BM_Process, Method::kEdLines)
       ->Unit(benchmark::kMillisecond);
+  const LineFrontendOptions defaults;
+  LineFrontendOptions one_octave = defaults;
+  one_octave.detector.num_octaves = 1;
+  LineFrontendOptions coarse_lbd = defaults;
+  coarse_lbd.descriptor.min_octave = 2;
+  LineFrontendOptions fewer_lines = defaults;
+  fewer_lines.merger.max_segments = 100;
+  for (const auto& [name, options] :
+       {std::pair<const char*, LineFrontendOptions>{"Textured/default", defaults},
+        {"Textured/num_octaves:1", one_octave},
+        {"Textured/descriptor_min_octave:2", coarse_lbd},
+        {"Textured/max_segments:100", fewer_lines}}) {
+    benchmark::RegisterBenchmark(name, BM_Textured, options)->Unit(benchmark::kMillisecond);
+  }
   if (std::filesystem::is_directory(std::filesystem::path(kKittiDir) / "rgb")) {
     // One pass over the sequence (199 processed + matched frames) per variant.
     benchmark::RegisterBenchmark("Kitti/lsd", BM_Kitti, Method::kLsd)
