@@ -20,6 +20,7 @@
 #include "core/evaluation.h"
 #include "core/synthetic/synthetic_sequence.h"
 #include "tests/backend/rendered_sequence.h"
+#include "tests/render_cache.h"
 
 namespace pldvo {
 namespace {
@@ -74,7 +75,7 @@ class EdgeDepthObserver : public OdometryObserver {
  public:
   bool WantsKeyframeMaps() const override { return true; }
   void OnKeyframeFinished(const KeyframeInfo& keyframe, const SemiDenseDepthMap& map) override {
-    const cv::Mat depth = synthetic::RenderFrame(Sequence().sequence, keyframe.frame_index).depth;
+    const cv::Mat depth = test::RenderFrameForTest(Sequence().sequence, keyframe.frame_index).depth;
     for (int i = 0; i < map.num_pixels(); ++i) {
       const float z = depth.at<float>(i / map.width(), i % map.width());
       if (!map.valid(i) || map.edge_id(i) < 0 || !(z > 0.0f)) continue;

@@ -1,5 +1,5 @@
-// Test helper: the small lowtex sequence (tests/small_lowtex_options.h) rendered, with every frame
-// as CV_32F and frame 0's depth.
+// Test helper: the small lowtex sequence (tests/small_lowtex_options.h) rendered (through the
+// test render cache, tests/render_cache.h), with every frame as CV_32F and frame 0's depth.
 #ifndef PLDVO_TESTS_BACKEND_RENDERED_SEQUENCE_H_
 #define PLDVO_TESTS_BACKEND_RENDERED_SEQUENCE_H_
 
@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/synthetic/synthetic_sequence.h"
+#include "tests/render_cache.h"
 #include "tests/small_lowtex_options.h"
 
 namespace pldvo::test {
@@ -23,7 +24,7 @@ inline RenderedSequence RenderLowtexSequence(int frames) {
   result.sequence = synthetic::MakeSequence(options);
   for (int i = 0; i < frames; ++i) {
     cv::Mat image;
-    const synthetic::RenderedFrame frame = synthetic::RenderFrame(result.sequence, i);
+    const synthetic::RenderedFrame frame = RenderFrameForTest(result.sequence, i);
     frame.image.convertTo(image, CV_32F);
     result.images.push_back(image);
     if (i == 0) result.first_depth = frame.depth;

@@ -27,6 +27,7 @@
 #include "core/synthetic/synthetic_sequence.h"
 #include "core/trajectory_io.h"
 #include "tests/experiments/test_folder.h"
+#include "tests/render_cache.h"
 #include "tests/small_lowtex_options.h"
 
 namespace pldvo {
@@ -58,16 +59,12 @@ constexpr int kHangSeconds = 300;
 using test::Slurp;
 using test::TestRoot;
 
-// A lowtex synthetic sequence of `frames` frames in TUM layout, written once per process and
-// length; returns its folder.
+// A lowtex synthetic sequence of `frames` frames in TUM layout, written once per ctest run and
+// length (tests/render_cache.h); returns its folder, which tests damage only through CopyOf.
 fs::path Sequence(int frames) {
-  const fs::path path = TestRoot() / ("lowtex_" + std::to_string(frames));
-  if (!fs::exists(path)) {
-    synthetic::SynthOptions options = test::SmallLowtexOptions(frames);
-    options.supersampling = kSupersampling;
-    synthetic::WriteSequence(synthetic::MakeSequence(options), path.string());
-  }
-  return path;
+  synthetic::SynthOptions options = test::SmallLowtexOptions(frames);
+  options.supersampling = kSupersampling;
+  return test::SequenceFolderForTest(options, TestRoot() / ("lowtex_" + std::to_string(frames)));
 }
 
 // A private copy of a sequence that a test may damage.

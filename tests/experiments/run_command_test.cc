@@ -19,6 +19,7 @@
 #include "core/synthetic/synthetic_sequence.h"
 #include "core/trajectory_io.h"
 #include "tests/experiments/test_folder.h"
+#include "tests/render_cache.h"
 #include "tests/small_lowtex_options.h"
 
 namespace pldvo {
@@ -30,16 +31,15 @@ constexpr int kFrames = 36;  // 1.2 s: RPE needs pairs 1 s apart
 using test::Slurp;
 using test::TestRoot;
 
-// The synthetic sequence (written once per test process).
+// The synthetic sequence (written once per ctest run, tests/render_cache.h; tests copy it before
+// damaging it).
 fs::path SequenceDir() {
   static const fs::path dir = [] {
     synthetic::SynthOptions options = test::SmallLowtexOptions(kFrames);
 #ifdef PLDVO_SANITIZE
     options.supersampling = 1;  // rendering dominates these tests under the sanitizers
 #endif
-    const fs::path path = TestRoot() / "lowtex";
-    synthetic::WriteSequence(synthetic::MakeSequence(options), path.string());
-    return path;
+    return test::SequenceFolderForTest(options, TestRoot() / "lowtex");
   }();
   return dir;
 }

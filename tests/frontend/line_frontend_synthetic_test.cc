@@ -15,6 +15,7 @@
 #include "core/synthetic/synthetic_sequence.h"
 #include "frontend/line_frontend.h"
 #include "tests/frontend/line_ground_truth.h"
+#include "tests/render_cache.h"
 
 namespace pldvo {
 namespace {
@@ -73,7 +74,7 @@ class LineFrontendSynthetic : public ::testing::Test {
           const int index = keyframe + gap;
           FrameData& f = scene.frames[index];
           f.world_from_cam = scene.sequence.ground_truth[index].world_from_cam;
-          f.rendered = synthetic::RenderFrame(scene.sequence, index);
+          f.rendered = test::RenderFrameForTest(scene.sequence, index);
           f.pieces = test::VisibleEdgePieces(scene.sequence, f.world_from_cam, f.rendered, 0.0);
           f.lines = frontend.Process(f.rendered.image);
           const int num_octaves = options.detector.first_octave + options.detector.num_octaves;
