@@ -110,13 +110,15 @@ inline synthetic::RenderedFrame RenderFrameForTest(const synthetic::SyntheticSeq
 }
 
 // synthetic::WriteSequence(MakeSequence(options)) into $PLDVO_TEST_RENDER_CACHE/<key>/<name of
-// `folder`>, once per ctest run, when the variable is set, else into `folder`; returns the folder
-// written. Callers copy it before changing anything in it.
+// `folder`>, once per ctest run, when the variable is set, else into `folder` unless it exists;
+// returns the folder written. Callers copy it before changing anything in it.
 inline std::filesystem::path SequenceFolderForTest(const synthetic::SynthOptions& options,
                                                    const std::filesystem::path& folder) {
   const char* cache_dir = std::getenv("PLDVO_TEST_RENDER_CACHE");
   if (cache_dir == nullptr || *cache_dir == '\0') {
-    synthetic::WriteSequence(synthetic::MakeSequence(options), folder.string());
+    if (!std::filesystem::is_directory(folder)) {
+      synthetic::WriteSequence(synthetic::MakeSequence(options), folder.string());
+    }
     return folder;
   }
   const std::filesystem::path parent =
