@@ -18,6 +18,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <memory>
 #include <string>
 
 #include "core/config_io.h"
@@ -77,6 +78,27 @@ inline void WriteFrame(const std::filesystem::path& path, const synthetic::Rende
   std::filesystem::rename(partial, path, error);
 }
 
+// The cache key of a set of synthesis options: a hash of all of them.
+inline std::string OptionsKey(const synthetic::SynthOptions& options) {
+  return std::to_string(std::hash<std::string>()(ConfigToString(options)));
+}
+
+// $PLDVO_TEST_RENDER_CACHE, or an empty path when it is not set.
+inline std::filesystem::path CacheDirFromEnvironment() {
+  const char* cache_dir = std::getenv("PLDVO_TEST_RENDER_CACHE");
+  return cache_dir == nullptr ? std::filesystem::path() : std::filesystem::path(cache_dir);
+}
+
+// `dir`, created if needed, with an exclusive lock on `dir`/`lock_name` held by `lock`.
+inline std::filesystem::path LockedDir(const std::filesystem::path& dir,
+                                       const std::string& lock_name,
+                                       std::unique_ptr<FileLock>* lock) {
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  *lock = std::make_unique<FileLock>(dir / lock_name);
+  return dir;
+}
+
 }  // namespace render_cache_internal
 
 // synthetic::RenderFrame(sequence, index), stored in and read from `cache_dir` (created if
@@ -85,13 +107,10 @@ inline synthetic::RenderedFrame RenderFrameCached(const synthetic::SyntheticSequ
                                                   int index,
                                                   const std::filesystem::path& cache_dir) {
   namespace internal = render_cache_internal;
-  const std::string key =
-      std::to_string(std::hash<std::string>()(ConfigToString(sequence.options))) + "_" +
-      std::to_string(index);
-  std::error_code error;
-  std::filesystem::create_directories(cache_dir, error);
-  const internal::FileLock lock(cache_dir / (key + ".lock"));
-  const std::filesystem::path path = cache_dir / (key + ".frame");
+  const std::string key = internal::OptionsKey(sequence.options) + "_" + std::to_string(index);
+  std::unique_ptr<internal::FileLock> lock;
+  const std::filesystem::path path =
+      internal::LockedDir(cache_dir, key + ".lock", &lock) / (key + ".frame");
   synthetic::RenderedFrame frame;
   if (internal::ReadFrame(path, sequence.camera.height, sequence.camera.width, &frame)) {
     return frame;
@@ -104,8 +123,8 @@ inline synthetic::RenderedFrame RenderFrameCached(const synthetic::SyntheticSequ
 // RenderFrameCached in $PLDVO_TEST_RENDER_CACHE when it is set, else synthetic::RenderFrame.
 inline synthetic::RenderedFrame RenderFrameForTest(const synthetic::SyntheticSequence& sequence,
                                                    int index) {
-  const char* cache_dir = std::getenv("PLDVO_TEST_RENDER_CACHE");
-  if (cache_dir == nullptr || *cache_dir == '\0') return synthetic::RenderFrame(sequence, index);
+  const std::filesystem::path cache_dir = render_cache_internal::CacheDirFromEnvironment();
+  if (cache_dir.empty()) return synthetic::RenderFrame(sequence, index);
   return RenderFrameCached(sequence, index, cache_dir);
 }
 
@@ -114,19 +133,17 @@ inline synthetic::RenderedFrame RenderFrameForTest(const synthetic::SyntheticSeq
 // returns the folder written. Callers copy it before changing anything in it.
 inline std::filesystem::path SequenceFolderForTest(const synthetic::SynthOptions& options,
                                                    const std::filesystem::path& folder) {
-  const char* cache_dir = std::getenv("PLDVO_TEST_RENDER_CACHE");
-  if (cache_dir == nullptr || *cache_dir == '\0') {
+  namespace internal = render_cache_internal;
+  const std::filesystem::path cache_dir = internal::CacheDirFromEnvironment();
+  if (cache_dir.empty()) {
     if (!std::filesystem::is_directory(folder)) {
       synthetic::WriteSequence(synthetic::MakeSequence(options), folder.string());
     }
     return folder;
   }
+  std::unique_ptr<internal::FileLock> lock;
   const std::filesystem::path parent =
-      std::filesystem::path(cache_dir) /
-      std::to_string(std::hash<std::string>()(ConfigToString(options)));
-  std::error_code error;
-  std::filesystem::create_directories(parent, error);
-  const render_cache_internal::FileLock lock(parent / "lock");
+      internal::LockedDir(cache_dir / internal::OptionsKey(options), "lock", &lock);
   // The folder keeps the name of `folder`: the runs name the sequence after it.
   const std::filesystem::path cached = parent / folder.filename();
   if (std::filesystem::is_directory(cached)) return cached;
