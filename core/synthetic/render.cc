@@ -15,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/synthetic/frustum_culler.h"
 #include "core/synthetic/synthetic_internal.h"
 #include "core/synthetic/synthetic_sequence.h"
 
@@ -65,19 +66,8 @@ class Renderer {
         supersampling_(supersampling),
         threads_(threads),
         tiles_x_((camera.width + kTile - 1) / kTile),
-        tiles_y_((camera.height + kTile - 1) / kTile) {
-    const auto& primitives = scene.primitives();
-    all_primitives_.resize(primitives.size());
-    for (size_t p = 0; p < primitives.size(); ++p) {
-      all_primitives_[p] = static_cast<int>(p);
-      Eigen::Matrix3d half_axes;  // columns: the box axes in the world, times the half sizes
-      for (int a = 0; a < 3; ++a) {
-        half_axes.col(a) =
-            primitives[p].box_from_world_rotation.row(a).transpose() * primitives[p].half_size[a];
-      }
-      half_axes_.push_back(half_axes);
-    }
-  }
+        tiles_y_((camera.height + kTile - 1) / kTile),
+        culler_(scene, camera) {}
 
   // Radiance (before gain, bias, vignetting, noise) and z-depth of every pixel.
   void Render(const SE3& world_from_cam, float* radiance, float* depth) const {
@@ -91,8 +81,8 @@ class Renderer {
       std::vector<int> candidates;
       int x0, y0, x1, y1;
       TileRange(tile, &x0, &y0, &x1, &y1);
-      FrustumCandidates(x0 - 0.5, y0 - 0.5, x1 - 0.5, y1 - 0.5, rotation, origin, all_primitives_,
-                        &candidates);
+      culler_.Candidates(x0 - 0.5, y0 - 0.5, x1 - 0.5, y1 - 0.5, rotation, origin, culler_.all(),
+                         &candidates);
       for (int y = y0; y < y1; ++y) {
         for (int x = x0; x < x1; ++x) {
           const int i = y * camera_.width + x;
@@ -135,13 +125,13 @@ class Renderer {
           }
           if (!boundary) continue;
           if (!have_candidates) {
-            FrustumCandidates(x0 - 0.5, y0 - 0.5, x1 - 0.5, y1 - 0.5, rotation, origin,
-                              all_primitives_, &candidates);
+            culler_.Candidates(x0 - 0.5, y0 - 0.5, x1 - 0.5, y1 - 0.5, rotation, origin,
+                               culler_.all(), &candidates);
             have_candidates = true;
           }
           // The sub-pixel rays only test what the pixel's own frustum can hold.
-          FrustumCandidates(x - 0.5, y - 0.5, x + 0.5, y + 0.5, rotation, origin, candidates,
-                            &pixel_candidates);
+          culler_.Candidates(x - 0.5, y - 0.5, x + 0.5, y + 0.5, rotation, origin, candidates,
+                             &pixel_candidates);
           double sum = 0.0;
           for (int sy = 0; sy < ss; ++sy) {
             for (int sx = 0; sx < ss; ++sx) {
@@ -170,40 +160,6 @@ class Renderer {
     *y1 = std::min(*y0 + kTile, camera_.height);
   }
 
-  // The primitives of `from` that may meet the frustum through the image rectangle
-  // [u0, u1] x [v0, v1]: a box is dropped when it lies entirely outside one of the frustum's
-  // four side planes (box-plane separation with the box's projected radius, exact for boxes).
-  // The room encloses the camera and is always kept.
-  void FrustumCandidates(double u0, double v0, double u1, double v1,
-                         const Eigen::Matrix3d& rotation, const Eigen::Vector3d& origin,
-                         const std::vector<int>& from, std::vector<int>* candidates) const {
-    const Eigen::Vector3d corner[4] = {rotation * camera_.Unproject(Eigen::Vector2d(u0, v0)),
-                                       rotation * camera_.Unproject(Eigen::Vector2d(u1, v0)),
-                                       rotation * camera_.Unproject(Eigen::Vector2d(u1, v1)),
-                                       rotation * camera_.Unproject(Eigen::Vector2d(u0, v1))};
-    const Eigen::Vector3d inside = corner[0] + corner[1] + corner[2] + corner[3];
-    Eigen::Vector3d normal[4];
-    for (int k = 0; k < 4; ++k) {
-      normal[k] = corner[k].cross(corner[(k + 1) % 4]);
-      if (normal[k].dot(inside) < 0.0) normal[k] = -normal[k];
-    }
-    candidates->clear();
-    const auto& primitives = scene_.primitives();
-    for (const int p : from) {
-      if (primitives[p].kind == Primitive::Kind::kRoom) {
-        candidates->push_back(p);
-        continue;
-      }
-      const Eigen::Vector3d offset = primitives[p].center_in_world - origin;
-      bool outside = false;
-      for (int k = 0; k < 4 && !outside; ++k) {
-        const double radius = (normal[k].transpose() * half_axes_[p]).cwiseAbs().sum();
-        outside = normal[k].dot(offset) < -radius * (1.0 + 1e-9) - 1e-12;
-      }
-      if (!outside) candidates->push_back(p);
-    }
-  }
-
   double Shade(const Scene::Hit& hit, const Eigen::Vector3d& origin,
                const Eigen::Vector3d& direction) const {
     const Eigen::Vector3d point = origin + hit.t * direction;
@@ -222,8 +178,7 @@ class Renderer {
   int supersampling_;
   int threads_;
   int tiles_x_, tiles_y_;
-  std::vector<int> all_primitives_;
-  std::vector<Eigen::Matrix3d> half_axes_;
+  FrustumCuller culler_;
 };
 
 ShadingParams MakeShading(const SyntheticSequence& sequence, const Lighting& lighting) {

@@ -11,10 +11,12 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 #include "core/camera_model.h"
 #include "core/camera_yaml.h"
 #include "core/config_io.h"
+#include "core/synthetic/frustum_culler.h"
 #include "core/synthetic/synthetic_internal.h"
 
 namespace pldvo::synthetic {
@@ -98,9 +100,10 @@ CameraPath DrawPath(const Scene& scene, const SynthOptions& options, double ampl
   return path;
 }
 
-// Counts scene edges with at least `min_visible_px` pixels of unoccluded projection.
+// Counts scene edges with at least `min_visible_px` pixels of unoccluded projection, up to
+// `enough`. `in_view`: the primitives that rays through the image can hit.
 int CountVisibleEdges(const Scene& scene, const PinholeCamera& camera, const SE3& world_from_cam,
-                      int enough) {
+                      const std::vector<int>& in_view, int enough) {
   const SE3 cam_from_world = world_from_cam.Inverse();
   constexpr int kSamples = 8;
   constexpr double kMinVisiblePx = 30.0;
@@ -117,7 +120,10 @@ int CountVisibleEdges(const Scene& scene, const PinholeCamera& camera, const SE3
       if (!camera.IsInside(pixel, 2.0)) continue;
       Scene::Hit hit;
       const Eigen::Vector3d direction = point - world_from_cam.translation();
-      if (!scene.Intersect(world_from_cam.translation(), direction, &hit)) continue;
+      if (!scene.IntersectSubset(world_from_cam.translation(), direction, in_view.data(),
+                                 static_cast<int>(in_view.size()), &hit)) {
+        continue;
+      }
       if (hit.t < 1.0 - 0.01 / direction.norm()) continue;  // occluded (1 cm tolerance)
       if (visible_samples == 0) first_pixel = pixel;
       last_pixel = pixel;
@@ -130,8 +136,10 @@ int CountVisibleEdges(const Scene& scene, const PinholeCamera& camera, const SE3
   return visible_edges;
 }
 
-// Minimum z-depth over a grid of rays covering the image, including its corners.
-double MinDepthOnGrid(const Scene& scene, const PinholeCamera& camera, const SE3& world_from_cam) {
+// Minimum z-depth over a grid of rays covering the image, including its corners. `in_view`: the
+// primitives that rays through the image can hit.
+double MinDepthOnGrid(const Scene& scene, const PinholeCamera& camera, const SE3& world_from_cam,
+                      const std::vector<int>& in_view) {
   constexpr int kCols = 24, kRows = 18;
   const Eigen::Matrix3d rotation = world_from_cam.rotation_matrix();
   double min_depth = std::numeric_limits<double>::infinity();
@@ -140,7 +148,8 @@ double MinDepthOnGrid(const Scene& scene, const PinholeCamera& camera, const SE3
       const Eigen::Vector2d pixel(-0.5 + c * camera.width / static_cast<double>(kCols),
                                   -0.5 + r * camera.height / static_cast<double>(kRows));
       Scene::Hit hit;
-      if (scene.Intersect(world_from_cam.translation(), rotation * camera.Unproject(pixel), &hit)) {
+      if (scene.IntersectSubset(world_from_cam.translation(), rotation * camera.Unproject(pixel),
+                                in_view.data(), static_cast<int>(in_view.size()), &hit)) {
         min_depth = std::min(min_depth, hit.t);  // t is the z-depth for a z = 1 ray
       }
     }
@@ -152,6 +161,9 @@ double MinDepthOnGrid(const Scene& scene, const PinholeCamera& camera, const SE3
 std::string CheckPath(const SyntheticSequence& sequence) {
   const SynthOptions& options = sequence.options;
   constexpr int kMinVisibleEdges = 4;
+  const PinholeCamera& camera = sequence.camera;
+  const FrustumCuller culler(sequence.scene, camera);
+  std::vector<int> in_view;
   for (const StampedPose& pose : sequence.ground_truth) {
     const SE3& world_from_cam = pose.world_from_cam;
     std::ostringstream failure;
@@ -161,12 +173,16 @@ std::string CheckPath(const SyntheticSequence& sequence) {
       failure << "clearance " << distance;
       return failure.str();
     }
-    const double min_depth = MinDepthOnGrid(sequence.scene, sequence.camera, world_from_cam);
+    // Both checks cast rays through the image only (exact culling).
+    culler.Candidates(-0.5, -0.5, camera.width - 0.5, camera.height - 0.5,
+                      world_from_cam.rotation_matrix(), world_from_cam.translation(), culler.all(),
+                      &in_view);
+    const double min_depth = MinDepthOnGrid(sequence.scene, camera, world_from_cam, in_view);
     if (min_depth < options.min_depth) {
       failure << "min depth " << min_depth;
       return failure.str();
     }
-    if (CountVisibleEdges(sequence.scene, sequence.camera, world_from_cam, kMinVisibleEdges) <
+    if (CountVisibleEdges(sequence.scene, camera, world_from_cam, in_view, kMinVisibleEdges) <
         kMinVisibleEdges) {
       failure << "fewer than " << kMinVisibleEdges << " visible edges";
       return failure.str();
