@@ -7,6 +7,7 @@
 #include "backend/odometry.h"
 #include "backend/odometry_observer.h"
 #include "core/evaluation.h"
+#include "core/wall_clock.h"
 
 namespace pldvo {
 namespace {
@@ -74,8 +75,7 @@ BootstrapRefinement RefineBootstrap(const Dataset& dataset, const OdometryConfig
     refinement.frames.push_back(i);
     refinement.points.push_back(capture.points());
   }
-  refinement.ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  refinement.ms = MsSince(start);
   return refinement;
 }
 

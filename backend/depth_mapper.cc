@@ -9,16 +9,10 @@
 
 #include "backend/depth_regularizer.h"
 #include "backend/line_stereo.h"
+#include "core/wall_clock.h"
 
 namespace pldvo {
-namespace {
-
-double ElapsedMs(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
-
-}  // namespace
+namespace {}  // namespace
 
 DepthMapper::DepthMapper(const PinholeCamera& camera, const MappingOptions& options)
     : camera_(camera), options_(options) {
@@ -173,7 +167,7 @@ FrameUpdateStats DepthMapper::UpdateWithFrame(const cv::Mat& image, const SE3& c
       if (pass == 0) ++stats.num_edge_pixels;
       UpdatePixel(i, current, geometry, lines_in_cur, &stats);
     }
-    (pass == 0 ? stats.edge_stereo_ms : stats.other_stereo_ms) = ElapsedMs(start);
+    (pass == 0 ? stats.edge_stereo_ms : stats.other_stereo_ms) = MsSince(start);
   }
   if (options_.regularize) {
     stats.removed = RemoveIsolatedHypotheses(options_, &map_);

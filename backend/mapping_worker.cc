@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "backend/reference_builder.h"
+#include "core/wall_clock.h"
 
 namespace pldvo {
 
@@ -58,9 +59,7 @@ double MappingWorker::Submit(MappingJob job) {
       if (wait_when_behind_) {
         const auto start = std::chrono::steady_clock::now();
         job_done_.wait(lock, [&] { return pending_updates() < max_pending_updates_; });
-        wait_ms =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-                .count();
+        wait_ms = MsSince(start);
       } else {
         for (auto it = queue_.begin(); it != queue_.end(); ++it) {
           if (it->kind == MappingJob::Kind::kUpdate) {
@@ -240,8 +239,7 @@ void MappingWorker::Run(const MappingJob& job) {
       failed_keyframe_id_ = job.keyframe_id;
     }
   }
-  const double ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double ms = MsSince(start);
   std::lock_guard<std::mutex> lock(mutex_);
   job_ms_.push_back(ms);
   recent_job_ms_ += ms;

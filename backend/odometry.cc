@@ -14,15 +14,10 @@
 #include "backend/edge_ba_solver.h"
 #include "backend/keyframe_selector.h"
 #include "backend/reference_builder.h"
+#include "core/wall_clock.h"
 
 namespace pldvo {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double MsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // a is a better tracking result than b: not lost beats lost, then more inlier rows at the
 // finest level. (Not the lower RMS: a wrong pose that pushes points out of the image or onto
@@ -71,6 +66,7 @@ Odometry::Odometry(const PinholeCamera& camera, const OdometryConfig& config,
     : camera_(camera),
       config_(config),
       observer_(observer),
+      preparer_(config),
       tracker_(config.tracking),
       retry_trigger_(config.odometry.retry_rms_ratio) {
   const std::string camera_error = camera.Check();
@@ -115,18 +111,39 @@ SE3 Odometry::PredictWorldFromCam(int index) const {
   return world_from_last_good_ * SE3::Exp(static_cast<double>(frames) * velocity_.Log());
 }
 
-OdometryFrameResult Odometry::ProcessFrame(int index, double timestamp, const cv::Mat& image,
-                                           const cv::Mat& depth) {
+void Odometry::CheckImage(int index, const cv::Mat& image) const {
   if (image.empty() || image.channels() != 1 || image.cols != camera_.width ||
       image.rows != camera_.height) {
     throw std::invalid_argument("Odometry::ProcessFrame: frame " + std::to_string(index) +
                                 " is not a gray image of " + std::to_string(camera_.width) + "x" +
                                 std::to_string(camera_.height));
   }
-  const auto start = Clock::now();
+}
+
+OdometryFrameResult Odometry::ProcessFrame(int index, double timestamp, const cv::Mat& image,
+                                           const cv::Mat& depth) {
+  CheckImage(index, image);
+  const auto start = WallClock::now();
+  PreparedFrame frame;
+  try {
+    frame = preparer_.Prepare(image);
+  } catch (const std::exception& e) {
+    return SkipFrame(index, timestamp, std::string("processing failed: ") + e.what());
+  }
+  return ProcessPrepared(index, timestamp, std::move(frame), depth, start);
+}
+
+OdometryFrameResult Odometry::ProcessFrame(int index, double timestamp, PreparedFrame frame,
+                                           const cv::Mat& depth) {
+  CheckImage(index, frame.image);
+  return ProcessPrepared(index, timestamp, std::move(frame), depth, WallClock::now());
+}
+
+OdometryFrameResult Odometry::ProcessPrepared(int index, double timestamp, PreparedFrame frame,
+                                              const cv::Mat& depth, WallClock::time_point start) {
   OdometryFrameResult result;
   try {
-    result = Process(index, timestamp, image, depth);
+    result = Process(index, timestamp, std::move(frame), depth);
   } catch (const std::exception& e) {
     return SkipFrame(index, timestamp, std::string("processing failed: ") + e.what());
   }
@@ -304,7 +321,7 @@ void Odometry::NotifyRetired(const KeyframeMap& map) {
 
 void Odometry::RefreshMap(OdometryTiming* timing) {
   if (map_ == nullptr || map_->keyframe_id != keyframe_.id) {
-    const auto start = Clock::now();
+    const auto start = WallClock::now();
     map_ = mapper_->WaitForKeyframe(keyframe_.id);
     timing->wait_ms += MsSince(start);
     if (map_ != nullptr) NotifyRetired(*map_);
@@ -343,24 +360,20 @@ TrackingResult Odometry::TrackWithAlternatives(const ImagePyramid& pyramid, cons
   return best;
 }
 
-OdometryFrameResult Odometry::Process(int index, double timestamp, const cv::Mat& image,
+OdometryFrameResult Odometry::Process(int index, double timestamp, PreparedFrame frame,
                                       const cv::Mat& depth) {
   OdometryFrameResult result;
   result.index = index;
   result.timestamp = timestamp;
   OdometryTiming& timing = result.timing;
 
-  auto start = Clock::now();
-  const ImagePyramid pyramid(image, config_.odometry.num_levels);
-  timing.pyramid_ms = MsSince(start);
-
-  LineFrame lines;
-  if (frontend_ != nullptr) {
-    lines = frontend_->Process(image);
-    timing.detection_ms = lines.timing.detection_ms + lines.timing.merging_ms;
-    timing.description_ms = lines.timing.description_ms;
-    result.num_lines = static_cast<int>(lines.segments.size());
-  }
+  const cv::Mat& image = frame.image;
+  const ImagePyramid& pyramid = frame.pyramid;
+  LineFrame& lines = frame.lines;
+  timing.pyramid_ms = frame.pyramid_ms;
+  timing.detection_ms = lines.timing.detection_ms + lines.timing.merging_ms;
+  timing.description_ms = lines.timing.description_ms;
+  result.num_lines = static_cast<int>(lines.segments.size());
 
   if (!initialized_) {
     StartKeyframe(index, timestamp, image, std::move(lines), SE3(), true, SE3(), 0, &timing,
@@ -401,7 +414,7 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, const cv::Mat
       lines_in_cur = MatchedLinesFromMatches(matches, lines.segments,
                                              static_cast<int>(keyframe_.lines.segments.size()));
     }
-    start = Clock::now();
+    auto start = WallClock::now();
     if (reference_source_ != map_->reference.get()) {
       reference_ = *map_->reference;
       reference_source_ = map_->reference.get();
@@ -409,7 +422,7 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, const cv::Mat
     SetMatchedLines(lines_in_cur, &reference_);
     timing.reference_ms = MsSince(start);
 
-    start = Clock::now();
+    start = WallClock::now();
     if (config_.odometry.line_prior_gate_px > 0.0 && result.num_matches > 0) {
       result.num_line_outliers = RemoveLineOutliers(
           prior_cur_from_kf, config_.odometry.line_prior_gate_px, &reference_, &lines_in_cur);
@@ -428,7 +441,7 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, const cv::Mat
     }
     timing.tracking_ms = MsSince(start);
     if (compare_tracker_ != nullptr && tracking.status != TrackingStatus::kLost) {
-      start = Clock::now();
+      start = WallClock::now();
       const TrackingResult other =
           compare_tracker_->Track(reference_, pyramid, tracking.initial_cur_from_ref);
       timing.compare_tracking_ms = MsSince(start);
@@ -454,7 +467,7 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, const cv::Mat
       recovering_ = false;
       ++keyframe_.frames_tracked;
 
-      start = Clock::now();
+      start = WallClock::now();
       const int overlap_level = std::min(2, reference_.num_levels() - 1);
       const double overlap = ReferenceOverlap(reference_, overlap_level, cur_from_kf);
       timing.reference_ms += MsSince(start);

@@ -2,7 +2,8 @@
 // Engel et al.'s semi-dense VO): what `pldvo run` drives. See docs/odometry.md.
 //
 // Per frame (ProcessFrame, on the caller's thread):
-//   1. image pyramid; line detection, merging and LBD (frontend/line_frontend.h);
+//   1. image pyramid; line detection, merging and LBD (frontend/line_frontend.h); a pure function
+//      of the image (FramePreparer), which a driver may run ahead on another thread;
 //   2. the keyframe's latest map (MappingWorker); keyframe lines matched into the frame, gated
 //      around their prediction by the pose prior;
 //   3. the tracking reference: the map's points per level (reference_builder.h) with the matched
@@ -31,6 +32,7 @@
 #include <vector>
 
 #include "backend/edge_ba_adjuster.h"
+#include "backend/frame_preparer.h"
 #include "backend/keyframe_window.h"
 #include "backend/mapping_worker.h"
 #include "backend/odometry_config.h"
@@ -40,6 +42,7 @@
 #include "core/image_pyramid.h"
 #include "core/pinhole_camera.h"
 #include "core/se3.h"
+#include "core/wall_clock.h"
 #include "frontend/line_frontend.h"
 
 namespace pldvo {
@@ -79,6 +82,11 @@ class Odometry {
   // when odometry.init_depth_idepth_var > 0.
   OdometryFrameResult ProcessFrame(int index, double timestamp, const cv::Mat& image,
                                    const cv::Mat& depth = cv::Mat());
+  // The same with the per-image work already done (FramePreparer with this odometry's config,
+  // e.g. on another thread); the result is identical, and tracking_thread_ms leaves out the
+  // preparation.
+  OdometryFrameResult ProcessFrame(int index, double timestamp, PreparedFrame frame,
+                                   const cv::Mat& depth = cv::Mat());
   // A frame that could not be loaded: kFailed with the extrapolated pose.
   OdometryFrameResult SkipFrame(int index, double timestamp, const std::string& reason);
   // Waits for the mapping thread and reports the last keyframe's map to the observer.
@@ -104,7 +112,12 @@ class Odometry {
     int frames_tracked = 0;
   };
 
-  OdometryFrameResult Process(int index, double timestamp, const cv::Mat& image,
+  // Throws std::invalid_argument when `image` is not a gray image of the camera's size.
+  void CheckImage(int index, const cv::Mat& image) const;
+  // ProcessFrame after the preparation; `start`: when the frame's work on this thread began.
+  OdometryFrameResult ProcessPrepared(int index, double timestamp, PreparedFrame frame,
+                                      const cv::Mat& depth, WallClock::time_point start);
+  OdometryFrameResult Process(int index, double timestamp, PreparedFrame frame,
                               const cv::Mat& depth);
   // Makes the frame the keyframe with id next_keyframe_id_: initial (random map) when
   // `initialize`, otherwise propagated from the current keyframe with new_from_old.
@@ -138,7 +151,8 @@ class Odometry {
   PinholeCamera camera_;
   OdometryConfig config_;
   OdometryObserver* observer_;
-  std::unique_ptr<LineFrontend> frontend_;
+  FramePreparer preparer_;                  // ProcessFrame(image)
+  std::unique_ptr<LineFrontend> frontend_;  // matching and tracing (null without lines)
   Tracker tracker_;
   std::unique_ptr<Tracker> compare_tracker_;  // odometry.compare_solver, else null
   std::unique_ptr<MappingWorker> mapper_;

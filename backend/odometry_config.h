@@ -101,6 +101,13 @@ struct OdometryOptions {
   // with wait_for_mapping, once mapping is the bottleneck, the thread's schedule is a lag of
   // mapping_queue_size + 1). Keyframe switches first run every held-back update, in order.
   int inline_mapping_lag = 0;
+  // `pldvo run`: the per-image work of frame i + 1 (pyramid, line detection, merging and LBD;
+  // FramePreparer) runs on the loading thread while frame i is tracked. It is a pure function of
+  // the image, so results do not change; tracking_thread then leaves it out, and the frame period
+  // (`total`) is the slower of the two stages. It pays where a core is free: with inline mapping
+  // on textured frames; with the mapping thread on 2 cores the three threads share them and the
+  // frame period grows (docs/odometry.md, "Threading"). false: all of it on the tracking thread.
+  bool frontend_thread = false;
   // Pending mapping updates kept when the mapping thread falls behind; older pending frames are
   // dropped (counted). Keyframe creations are never dropped.
   int mapping_queue_size = 2;
@@ -153,6 +160,9 @@ struct OdometryOptions {
             "Mapping in its own thread; false runs it inline (deterministic).");
     v.Field("inline_mapping_lag", &inline_mapping_lag,
             "parallel_mapping false: frames tracked before a frame's map update runs (default 0).");
+    v.Field("frontend_thread", &frontend_thread,
+            "pldvo run: prepare frame i + 1 (pyramid, lines, LBD) on the loading thread while "
+            "frame i is tracked (default false); results are unchanged.");
     v.Field("mapping_queue_size", &mapping_queue_size,
             "Pending mapping updates kept when mapping falls behind (default 2).");
     v.Field("wait_for_mapping", &wait_for_mapping,

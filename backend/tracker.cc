@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "core/wall_clock.h"
 #include "residuals/covariance_models.h"
 #include "residuals/photometric_residual.h"
 #include "residuals/point_to_line_residual.h"
@@ -196,8 +197,7 @@ TrackingResult Tracker::Track(const TrackingReference& reference, const ImagePyr
   } else {
     result.status = finest.converged ? TrackingStatus::kConverged : TrackingStatus::kNotConverged;
   }
-  result.ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  result.ms = MsSince(start);
   return result;
 }
 

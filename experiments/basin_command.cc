@@ -25,6 +25,7 @@
 
 #include "backend/tracker.h"
 #include "core/config_io.h"
+#include "core/wall_clock.h"
 #include "experiments/command.h"
 #include "experiments/synthetic_pairs.h"
 
@@ -157,9 +158,7 @@ int RunBasin(const CommandContext& context) {
       for (int m = 0; m < kNumModes; ++m) {
         const auto start = std::chrono::steady_clock::now();
         const TrackingResult result = trackers[m].Track(reference, current, SE3());
-        const double ms =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-                .count();
+        const double ms = MsSince(start);
         milliseconds[m] += ms;
         const double t_error =
             synthetic_pairs::TranslationError(result.cur_from_ref, pair.cur_from_ref);

@@ -33,17 +33,20 @@
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "backend/bootstrap_refiner.h"
+#include "backend/frame_preparer.h"
 #include "backend/odometry.h"
 #include "backend/odometry_config.h"
 #include "core/config_io.h"
 #include "core/dataset.h"
 #include "core/evaluation.h"
 #include "core/trajectory_io.h"
+#include "core/wall_clock.h"
 #include "experiments/command.h"
 #include "experiments/common_flags.h"
 #include "experiments/run_outputs.h"
@@ -55,12 +58,6 @@ DEFINE_bool(list_config, false, "Print every config key with its default and doc
 
 namespace pldvo {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double MsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // The per-frame timing columns, in timing.csv order; the summary's ms objects use the same keys.
 struct TimingRow {
@@ -88,10 +85,11 @@ nlohmann::json NumberOrNull(double value) {
 
 class ProgressBar {
  public:
-  ProgressBar(int total, bool enabled) : total_(total), enabled_(enabled), start_(Clock::now()) {}
+  ProgressBar(int total, bool enabled)
+      : total_(total), enabled_(enabled), start_(WallClock::now()) {}
   void Update(int done, int lost) {
     if (!enabled_) return;
-    const auto now = Clock::now();
+    const auto now = WallClock::now();
     if (done < total_ && now - last_ < std::chrono::milliseconds(100)) return;
     last_ = now;
     const double seconds = std::chrono::duration<double>(now - start_).count();
@@ -107,19 +105,23 @@ class ProgressBar {
  private:
   int total_;
   bool enabled_;
-  Clock::time_point start_;
-  Clock::time_point last_;
+  WallClock::time_point start_;
+  WallClock::time_point last_;
 };
 
 struct LoadedFrame {
   Frame frame;
   std::string error;  // non-empty when loading failed
   double load_ms = 0.0;
+  // odometry.frontend_thread: the frame's per-image work, done on the loading thread.
+  std::optional<PreparedFrame> prepared;
 };
 
-LoadedFrame LoadFrame(const Dataset& dataset, int index) {
+// Loads frame `index` and, with a `preparer`, prepares it on the same (loading) thread. A frame
+// that is not a gray image of the camera's size is left unprepared: ProcessFrame reports it.
+LoadedFrame LoadFrame(const Dataset& dataset, int index, FramePreparer* preparer) {
   LoadedFrame loaded;
-  const auto start = Clock::now();
+  const auto start = WallClock::now();
   try {
     loaded.frame = dataset.Load(index);
     if (loaded.frame.image.empty()) loaded.error = "empty image " + loaded.frame.path;
@@ -127,6 +129,16 @@ LoadedFrame LoadFrame(const Dataset& dataset, int index) {
     loaded.error = e.what();
   }
   loaded.load_ms = MsSince(start);
+  const cv::Mat& image = loaded.frame.image;
+  const PinholeCamera& camera = dataset.camera();
+  if (preparer != nullptr && loaded.error.empty() && image.channels() == 1 &&
+      image.cols == camera.width && image.rows == camera.height) {
+    try {
+      loaded.prepared = preparer->Prepare(image);
+    } catch (const std::exception&) {
+      loaded.prepared.reset();  // ProcessFrame(image) repeats the work and reports the failure
+    }
+  }
   return loaded;
 }
 
@@ -235,16 +247,21 @@ int RunOdometryCommand(const CommandContext& context) {
   std::vector<TimingRow> rows;
   Trajectory estimate;
   int failed = 0;
-  const auto run_start = Clock::now();
-  // Frame i + 1 is loaded (decoded, undistorted) while frame i is processed.
+  const auto run_start = WallClock::now();
+  // Frame i + 1 is loaded (decoded, undistorted) while frame i is processed, and with
+  // odometry.frontend_thread also prepared (pyramid, line detection and description). One task
+  // runs at a time, so the preparer is never used by two threads at once.
+  std::unique_ptr<FramePreparer> preparer;
+  if (run_config.odometry.frontend_thread) preparer = std::make_unique<FramePreparer>(run_config);
+  const auto load = [&](int index) {
+    return std::async(std::launch::async, LoadFrame, std::cref(*dataset), index, preparer.get());
+  };
   std::future<LoadedFrame> next;
-  if (num_frames > 0) next = std::async(std::launch::async, LoadFrame, std::cref(*dataset), 0);
+  if (num_frames > 0) next = load(0);
   for (int i = 0; i < num_frames; ++i) {
-    const auto frame_start = Clock::now();
+    const auto frame_start = WallClock::now();
     LoadedFrame loaded = next.get();
-    if (i + 1 < num_frames) {
-      next = std::async(std::launch::async, LoadFrame, std::cref(*dataset), i + 1);
-    }
+    if (i + 1 < num_frames) next = load(i + 1);
     OdometryFrameResult result;
     if (!loaded.error.empty()) {
       std::cerr << (isatty(STDERR_FILENO) ? "\n" : "") << "pldvo run: frame " << i
@@ -263,7 +280,10 @@ int RunOdometryCommand(const CommandContext& context) {
                 "image for frame 0");
           }
         }
-        result = odometry->ProcessFrame(i, loaded.frame.timestamp, loaded.frame.image, depth);
+        result = loaded.prepared.has_value()
+                     ? odometry->ProcessFrame(i, loaded.frame.timestamp,
+                                              std::move(*loaded.prepared), depth)
+                     : odometry->ProcessFrame(i, loaded.frame.timestamp, loaded.frame.image, depth);
       } catch (const std::exception& e) {
         std::cerr << "pldvo run: frame " << i << " (" << loaded.frame.path
                   << ") skipped: " << e.what() << "\n";
@@ -309,7 +329,7 @@ int RunOdometryCommand(const CommandContext& context) {
     progress.Update(i + 1, odometry->statistics().lost_frames);
   }
   odometry->Finish();
-  const double run_seconds = std::chrono::duration<double>(Clock::now() - run_start).count();
+  const double run_seconds = std::chrono::duration<double>(WallClock::now() - run_start).count();
   const OdometryStatistics stats = odometry->statistics();
 
   // Summary.
@@ -326,6 +346,7 @@ int RunOdometryCommand(const CommandContext& context) {
   summary["dropped_mapping_updates"] = stats.dropped_mapping_updates;
   summary["failed_mapping_jobs"] = stats.failed_mapping_jobs;
   summary["parallel_mapping"] = config.odometry.parallel_mapping;
+  summary["frontend_thread"] = config.odometry.frontend_thread;
   summary["seconds"] = run_seconds;
   // odometry.bootstrap_passes > 1: frames and first-keyframe hypotheses per refinement pass, and
   // their wall time (before the run; not in `seconds`).

@@ -4,14 +4,10 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "core/wall_clock.h"
+
 namespace pldvo {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 const LineFrontendOptions& Checked(const LineFrontendOptions& options) {
   const std::string error = options.Check();
@@ -31,34 +27,34 @@ LineFrontend::LineFrontend(const LineFrontendOptions& options)
 
 LineFrame LineFrontend::Process(const cv::Mat& image) {
   LineFrame frame;
-  Clock::time_point start = Clock::now();
+  WallClock::time_point start = WallClock::now();
   const cv::Mat gray = ToGray8(image);
   frame.image_size = gray.size();
   const std::vector<cv::Mat> octaves =
       BuildOctaves(gray, options_.detector.first_octave + options_.detector.num_octaves);
   const std::vector<LineSegment> detected = detector_.Detect(octaves);
-  frame.timing.detection_ms = MillisecondsSince(start);
+  frame.timing.detection_ms = MsSince(start);
   frame.timing.num_detected = static_cast<int>(detected.size());
 
-  start = Clock::now();
+  start = WallClock::now();
   frame.segments = merger_.Merge(detected);
-  frame.timing.merging_ms = MillisecondsSince(start);
+  frame.timing.merging_ms = MsSince(start);
   frame.timing.num_lines = static_cast<int>(frame.segments.size());
 
-  start = Clock::now();
+  start = WallClock::now();
   frame.descriptors = describer_.Describe(gray, frame.segments);
-  frame.timing.description_ms = MillisecondsSince(start);
+  frame.timing.description_ms = MsSince(start);
   return frame;
 }
 
 std::vector<LineMatch> LineFrontend::Match(const LineFrame& keyframe, const LineFrame& frame,
                                            const SegmentPredictor& predictor,
                                            LineFrontendTiming* timing) const {
-  const Clock::time_point start = Clock::now();
+  const WallClock::time_point start = WallClock::now();
   std::vector<LineMatch> matches = matcher_.Match(keyframe.segments, keyframe.descriptors,
                                                   frame.segments, frame.descriptors, predictor);
   if (timing != nullptr) {
-    timing->matching_ms += MillisecondsSince(start);
+    timing->matching_ms += MsSince(start);
     timing->num_matches += static_cast<int>(matches.size());
   }
   return matches;
@@ -67,14 +63,14 @@ std::vector<LineMatch> LineFrontend::Match(const LineFrame& keyframe, const Line
 EdgeTrace LineFrontend::TraceMatched(const LineFrame& keyframe,
                                      const std::vector<LineMatch>& matches,
                                      LineFrontendTiming* timing) const {
-  const Clock::time_point start = Clock::now();
+  const WallClock::time_point start = WallClock::now();
   std::vector<int> ids;
   ids.reserve(matches.size());
   for (const LineMatch& match : matches) ids.push_back(match.ref_index);
   std::sort(ids.begin(), ids.end());
   ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
   EdgeTrace trace = tracer_.Trace(keyframe.segments, ids, keyframe.image_size);
-  if (timing != nullptr) timing->tracing_ms += MillisecondsSince(start);
+  if (timing != nullptr) timing->tracing_ms += MsSince(start);
   return trace;
 }
 

@@ -12,9 +12,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <string>
 #include <vector>
 
+#include "backend/frame_preparer.h"
 #include "backend/odometry_config.h"
 #include "core/config_io.h"
 #include "core/evaluation.h"
@@ -147,6 +149,41 @@ TEST(OdometryTest, DeterministicModeRepeatsExactly) {
 // differences median 4.2e-5 m, max 1.8e-4 m (1.4% of that frame's motion; Gauss-Newton stops at
 // its function tolerance a little before Ceres' LM), max rotation 9e-5 rad; RPE 0.881 vs 0.884
 // cm/s (0.3%). A solver that failed on some frames would differ by millimetres.
+// odometry.frontend_thread: frames prepared (pyramid, lines, LBD) on another thread, one ahead,
+// as `pldvo run` does, give the run of ProcessFrame(image) bit for bit.
+TEST(OdometryTest, FramesPreparedOnAnotherThreadGiveTheSameRun) {
+  const OdometryConfig config = DeterministicConfig();
+  const RunResult plain = RunSequence(config, {}, kRepeatFrames);
+  const RenderedSequence& rendered = Sequence();
+  Odometry odometry(rendered.sequence.camera, config);
+  FramePreparer preparer(config);
+  const auto prepare = [&](int i) {
+    return std::async(std::launch::async,
+                      [&preparer, &rendered, i] { return preparer.Prepare(rendered.images[i]); });
+  };
+  std::future<PreparedFrame> next = prepare(0);
+  for (int i = 0; i < kRepeatFrames; ++i) {
+    PreparedFrame frame = next.get();
+    if (i + 1 < kRepeatFrames) next = prepare(i + 1);
+    const OdometryFrameResult result =
+        odometry.ProcessFrame(i, rendered.sequence.ground_truth[i].timestamp, std::move(frame),
+                              i == 0 ? rendered.first_depth : cv::Mat());
+    const OdometryFrameResult& expected = plain.frames[i];
+    ASSERT_EQ(result.status, expected.status) << "frame " << i;
+    EXPECT_EQ(result.num_lines, expected.num_lines) << "frame " << i;
+    EXPECT_EQ(result.num_matches, expected.num_matches) << "frame " << i;
+    EXPECT_EQ(result.world_from_cam.translation(), expected.world_from_cam.translation())
+        << "frame " << i;
+    EXPECT_EQ(result.world_from_cam.rotation().coeffs(),
+              expected.world_from_cam.rotation().coeffs())
+        << "frame " << i;
+  }
+  odometry.Finish();
+  // A prepared frame of the wrong size is refused like an image.
+  PreparedFrame small = preparer.Prepare(rendered.images[0].colRange(0, 64).clone());
+  EXPECT_THROW(odometry.ProcessFrame(kRepeatFrames, 0.0, std::move(small)), std::invalid_argument);
+}
+
 TEST(OdometryTest, CompareSolverSolvesTheSameProblemsWithoutChangingTheRun) {
   // The run without the comparison, on the repeatability prefix: a deterministic run's first
   // frames do not depend on how many follow.

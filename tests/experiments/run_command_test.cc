@@ -145,6 +145,29 @@ TEST(RunCommandTest, CorruptFrameIsSkippedAndTheTrajectorySurvives) {
   EXPECT_EQ(summary["lost_events"], 1);
 }
 
+// odometry.frontend_thread: frame i + 1 prepared on the loading thread gives the same trajectory
+// (a prefix of the sequence keeps the two runs cheap under the sanitizers).
+TEST(RunCommandTest, FrontendThreadGivesTheSameTrajectory) {
+  std::string trajectories[2];
+  for (const bool frontend_thread : {false, true}) {
+    const std::string name = std::string("run_frontend_thread_") + (frontend_thread ? "1" : "0");
+    const fs::path out = TestRoot() / name;
+    const fs::path log = TestRoot() / (name + ".log");
+    ASSERT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " + out.string() +
+                        kDeterministic + " --max_frames 12 --set odometry.frontend_thread=" +
+                        (frontend_thread ? "true" : "false"),
+                    log),
+              0)
+        << Slurp(log);
+    trajectories[frontend_thread] = Slurp(out / "trajectory.txt");
+    const nlohmann::json summary = nlohmann::json::parse(Slurp(out / "summary.json"));
+    EXPECT_EQ(summary["frontend_thread"], frontend_thread);
+    EXPECT_EQ(summary["tracked"], 12);
+    EXPECT_GT(summary["ms_median"]["detection"].get<double>(), 0.0);
+  }
+  EXPECT_EQ(trajectories[1], trajectories[0]);
+}
+
 // Rows of a CSV file with a header line, each split at commas.
 std::vector<std::vector<std::string>> CsvRows(const fs::path& path) {
   std::vector<std::vector<std::string>> rows;
