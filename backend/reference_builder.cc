@@ -14,31 +14,72 @@ namespace {
 struct LevelSums {
   int width = 0;
   int height = 0;
-  std::vector<double> weighted_idepth;  // sum idepth_i / V_i
-  std::vector<double> weight;           // sum 1 / V_i
-  std::vector<int> count;               // n
-  std::vector<int> edge_id;
-  std::vector<double> edge_weight;  // 1 / V of the pixel that gave edge_id
+  std::vector<double> weighted_idepths;  // sum idepth_i / V_i
+  std::vector<double> weights;           // sum 1 / V_i
+  std::vector<int> counts;               // n
+  std::vector<int> edge_ids;
+  std::vector<double> edge_weights;  // 1 / V of the pixel that gave edge_id
 
-  void Resize(int w, int h) {
-    width = w;
-    height = h;
+  LevelSums(int w, int h) : width(w), height(h) {
     const size_t n = static_cast<size_t>(w) * h;
-    weighted_idepth.assign(n, 0.0);
-    weight.assign(n, 0.0);
-    count.assign(n, 0);
-    edge_id.assign(n, -1);
-    edge_weight.assign(n, 0.0);
+    weighted_idepths.assign(n, 0.0);
+    weights.assign(n, 0.0);
+    counts.assign(n, 0);
+    edge_ids.assign(n, -1);
+    edge_weights.assign(n, 0.0);
   }
+  double weighted_idepth(int i) const { return weighted_idepths[i]; }
+  double weight(int i) const { return weights[i]; }
+  int count(int i) const { return counts[i]; }
+  int edge_id(int i) const { return edge_ids[i]; }
+  double edge_weight(int i) const { return edge_weights[i]; }
 };
 
-// Keeps max_points evenly spaced entries of `points` (raster order), index floor(k n / max).
-void ThinEvenly(int max_points, std::vector<ReferencePoint>* points) {
-  const size_t n = points->size();
-  if (max_points <= 0 || n <= static_cast<size_t>(max_points)) return;
-  const size_t kept = static_cast<size_t>(max_points);
-  for (size_t k = 0; k < kept; ++k) (*points)[k] = (*points)[k * n / kept];
-  points->resize(kept);
+// Level 0: the map's hypotheses as one-hypothesis sums, read in place (no level-sized copy).
+struct MapSums {
+  const SemiDenseDepthMap& map;
+  int width;
+  int height;
+
+  explicit MapSums(const SemiDenseDepthMap& m) : map(m), width(m.width()), height(m.height()) {}
+  int count(int i) const {
+    if (!map.valid(i)) return 0;
+    const double idepth = map.idepth(i), var = map.idepth_var(i);
+    return idepth >= 0.0 && var > 0.0 ? 1 : 0;
+  }
+  double weighted_idepth(int i) const {
+    return static_cast<double>(map.idepth(i)) / static_cast<double>(map.idepth_var(i));
+  }
+  double weight(int i) const { return 1.0 / static_cast<double>(map.idepth_var(i)); }
+  int edge_id(int i) const { return map.edge_id(i) >= 0 ? map.edge_id(i) : -1; }
+  double edge_weight(int i) const { return map.edge_id(i) >= 0 ? weight(i) : 0.0; }
+};
+
+// The sums of the next coarser level (w x h): each pixel aggregates its 2x2 children of `fine`.
+template <class Sums>
+LevelSums Aggregate(const Sums& fine, int w, int h) {
+  LevelSums coarse(w, h);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const int i = y * w + x;
+      for (int dy = 0; dy < 2; ++dy) {
+        for (int dx = 0; dx < 2; ++dx) {
+          const int cx = 2 * x + dx, cy = 2 * y + dy;
+          if (cx >= fine.width || cy >= fine.height) continue;
+          const int c = cy * fine.width + cx;
+          if (fine.count(c) == 0) continue;
+          coarse.weighted_idepths[i] += fine.weighted_idepth(c);
+          coarse.weights[i] += fine.weight(c);
+          coarse.counts[i] += fine.count(c);
+          if (fine.edge_id(c) >= 0 && fine.edge_weight(c) > coarse.edge_weights[i]) {
+            coarse.edge_ids[i] = fine.edge_id(c);
+            coarse.edge_weights[i] = fine.edge_weight(c);
+          }
+        }
+      }
+    }
+  }
+  return coarse;
 }
 
 // The foot point of `pixel` on the level-0 line `line_at_level0` expressed at `level`; `pixel`
@@ -52,22 +93,33 @@ Eigen::Vector2d FootPoint(const Eigen::Vector2d& pixel, const Eigen::Vector3d& l
   return pixel - (l.head<2>().dot(pixel) + l.z()) * l.head<2>();
 }
 
-void AddPoints(const LevelSums& sums, const ImagePyramid& keyframe,
-               const std::vector<Eigen::Vector3d>& keyframe_lines, int level,
+// Adds the level's points in raster order; with max_points > 0 and more candidates n than that,
+// only max_points evenly spaced ones: candidate ordinals floor(k n / max_points), k = 0, 1, ...
+// (so a thinned level costs one pass, and no point is built only to be dropped).
+template <class Sums>
+void AddPoints(const Sums& sums, const ImagePyramid& keyframe,
+               const std::vector<Eigen::Vector3d>& keyframe_lines, int level, int max_points,
                TrackingReferenceLevel* out) {
+  const auto is_candidate = [&sums](int i) { return sums.count(i) > 0 && sums.weight(i) > 0.0; };
+  size_t n = 0;
+  for (int i = 0; i < sums.width * sums.height; ++i) n += is_candidate(i);
+  const size_t kept = max_points > 0 ? std::min(n, static_cast<size_t>(max_points)) : n;
+  out->points.reserve(out->points.size() + kept);
+  size_t ordinal = 0, next = 0;  // candidate ordinal, index k of the next one kept
   const cv::Mat& image = keyframe.level(level);
-  out->points.reserve(out->points.size() + sums.width * sums.height / 8);
-  for (int y = 0; y < sums.height; ++y) {
+  for (int y = 0; y < sums.height && next < kept; ++y) {
     const float* row = image.ptr<float>(y);
-    for (int x = 0; x < sums.width; ++x) {
+    for (int x = 0; x < sums.width && next < kept; ++x) {
       const int i = y * sums.width + x;
-      if (sums.count[i] == 0 || !(sums.weight[i] > 0.0)) continue;
+      if (!is_candidate(i)) continue;
+      if (ordinal++ != next * n / kept) continue;
+      ++next;
       ReferencePoint point;
       point.pixel = Eigen::Vector2d(x, y);
-      point.idepth = sums.weighted_idepth[i] / sums.weight[i];
-      point.idepth_var = sums.count[i] / sums.weight[i];
+      point.idepth = sums.weighted_idepth(i) / sums.weight(i);
+      point.idepth_var = sums.count(i) / sums.weight(i);
       point.intensity = row[3 * x];
-      point.edge_id = sums.edge_id[i];
+      point.edge_id = sums.edge_id(i);
       point.pixel_on_edge =
           point.edge_id >= 0 && point.edge_id < static_cast<int>(keyframe_lines.size())
               ? FootPoint(point.pixel, keyframe_lines[point.edge_id], level)
@@ -90,52 +142,17 @@ TrackingReference BuildReferencePoints(const SemiDenseDepthMap& map, const Image
   }
   TrackingReference reference;
   reference.levels.resize(keyframe.num_levels());
-  LevelSums sums;
-  sums.Resize(map.width(), map.height());
-  for (int i = 0; i < map.num_pixels(); ++i) {
-    if (!map.valid(i)) continue;
-    const double idepth = map.idepth(i);
-    const double var = map.idepth_var(i);
-    if (!(idepth >= 0.0) || !(var > 0.0)) continue;
-    sums.weighted_idepth[i] = idepth / var;
-    sums.weight[i] = 1.0 / var;
-    sums.count[i] = 1;
-    if (map.edge_id(i) >= 0) {
-      sums.edge_id[i] = map.edge_id(i);
-      sums.edge_weight[i] = 1.0 / var;
-    }
-  }
-  for (int level = 0; level < keyframe.num_levels(); ++level) {
-    TrackingReferenceLevel& out = reference.levels[level];
-    out.camera = camera.AtLevel(level);
-    if (level > 0) {
-      // Aggregate the 2x2 children of the finer level (its sums are over level-0 pixels).
-      LevelSums coarse;
-      coarse.Resize(keyframe.width(level), keyframe.height(level));
-      for (int y = 0; y < coarse.height; ++y) {
-        for (int x = 0; x < coarse.width; ++x) {
-          const int i = y * coarse.width + x;
-          for (int dy = 0; dy < 2; ++dy) {
-            for (int dx = 0; dx < 2; ++dx) {
-              const int cx = 2 * x + dx, cy = 2 * y + dy;
-              if (cx >= sums.width || cy >= sums.height) continue;
-              const int c = cy * sums.width + cx;
-              if (sums.count[c] == 0) continue;
-              coarse.weighted_idepth[i] += sums.weighted_idepth[c];
-              coarse.weight[i] += sums.weight[c];
-              coarse.count[i] += sums.count[c];
-              if (sums.edge_id[c] >= 0 && sums.edge_weight[c] > coarse.edge_weight[i]) {
-                coarse.edge_id[i] = sums.edge_id[c];
-                coarse.edge_weight[i] = sums.edge_weight[c];
-              }
-            }
-          }
-        }
-      }
-      sums = std::move(coarse);
-    }
-    AddPoints(sums, keyframe, keyframe_lines, level, &out);
-    ThinEvenly(max_points_per_level, &out.points);
+  const auto camera_at = [&](int level) {
+    reference.levels[level].camera = camera.AtLevel(level);
+    return &reference.levels[level];
+  };
+  const MapSums level0(map);
+  AddPoints(level0, keyframe, keyframe_lines, 0, max_points_per_level, camera_at(0));
+  if (keyframe.num_levels() < 2) return reference;
+  LevelSums sums = Aggregate(level0, keyframe.width(1), keyframe.height(1));
+  for (int level = 1; level < keyframe.num_levels(); ++level) {
+    if (level > 1) sums = Aggregate(sums, keyframe.width(level), keyframe.height(level));
+    AddPoints(sums, keyframe, keyframe_lines, level, max_points_per_level, camera_at(level));
   }
   return reference;
 }

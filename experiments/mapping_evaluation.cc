@@ -9,6 +9,7 @@
 
 #include "backend/depth_map_io.h"
 #include "backend/depth_mapper.h"
+#include "experiments/synthetic_pairs.h"
 
 namespace pldvo {
 namespace {
@@ -18,14 +19,6 @@ struct Frame {
   cv::Mat depth;
   SE3 world_from_cam;
 };
-
-std::vector<EdgeSegment> SegmentsInCam(const synthetic::Scene& scene, const SE3& cam_from_world) {
-  std::vector<EdgeSegment> segments;
-  for (const synthetic::Segment3d& edge : scene.edges()) {
-    segments.push_back({cam_from_world * edge.start_in_world, cam_from_world * edge.end_in_world});
-  }
-  return segments;
-}
 
 MapEvalRun RunVariant(const MapEvalConfig& config, bool line_stereo, double line_sigma_px,
                       const synthetic::SyntheticSequence& sequence, const Frame& keyframe,
@@ -120,9 +113,9 @@ MapEvalResult RunMapEvaluation(const MapEvalConfig& config) {
   for (int k = 1; k <= config.num_frames; ++k) {
     frames.push_back(render(config.keyframe_index + k * config.frame_stride));
   }
-  const GroundTruthEdges gt_edges =
-      MakeGroundTruthEdges(SegmentsInCam(sequence.scene, keyframe.world_from_cam.Inverse()),
-                           keyframe.depth, sequence.camera, GroundTruthEdgeOptions());
+  const GroundTruthEdges gt_edges = MakeGroundTruthEdges(
+      synthetic_pairs::SegmentsInCam(sequence.scene, keyframe.world_from_cam.Inverse()),
+      keyframe.depth, sequence.camera, GroundTruthEdgeOptions());
   MapEvalResult result;
   result.width = sequence.camera.width;
   result.height = sequence.camera.height;
@@ -182,9 +175,9 @@ MapEvalResult RunMapEvaluation(const MapEvalConfig& config) {
                        keyframe.world_from_cam, config.out_dir + "/keyframe_points.ply");
   }
   const Frame& last = frames.back();
-  const GroundTruthEdges last_edges =
-      MakeGroundTruthEdges(SegmentsInCam(sequence.scene, last.world_from_cam.Inverse()), last.depth,
-                           sequence.camera, GroundTruthEdgeOptions());
+  const GroundTruthEdges last_edges = MakeGroundTruthEdges(
+      synthetic_pairs::SegmentsInCam(sequence.scene, last.world_from_cam.Inverse()), last.depth,
+      sequence.camera, GroundTruthEdgeOptions());
   const PropagationStats propagation = mapper.PropagateToNewKeyframe(
       last.image, last_edges.trace, last.world_from_cam.Inverse() * keyframe.world_from_cam);
   result.propagated_count = propagation.propagated;

@@ -1,6 +1,7 @@
 // Frame pairs from the synthetic renderer with ground-truth depth, poses and 3D edges, and the
 // ground-truth tracking reference of a pair (header-only; link pldvo_backend and
-// pldvo_synthetic). Used by the tracking tests, `pldvo basin` and the tracking benchmark.
+// pldvo_synthetic). Used by the tracking tests, `pldvo basin`, `pldvo mapeval` and the tracking
+// and mapping benchmarks.
 #ifndef PLDVO_EXPERIMENTS_SYNTHETIC_PAIRS_H_
 #define PLDVO_EXPERIMENTS_SYNTHETIC_PAIRS_H_
 
@@ -31,6 +32,17 @@ inline synthetic::SyntheticSequence MakeScaledSequence(const std::string& preset
   return synthetic::MakeSequence(options);
 }
 
+// The scene's 3D edges in a camera's frame.
+inline std::vector<EdgeSegment> SegmentsInCam(const synthetic::Scene& scene,
+                                              const SE3& cam_from_world) {
+  std::vector<EdgeSegment> segments;
+  segments.reserve(scene.edges().size());
+  for (const synthetic::Segment3d& edge : scene.edges()) {
+    segments.push_back({cam_from_world * edge.start_in_world, cam_from_world * edge.end_in_world});
+  }
+  return segments;
+}
+
 struct FramePair {
   PinholeCamera camera;
   cv::Mat ref_image, ref_depth, cur_image;
@@ -49,11 +61,7 @@ inline FramePair MakeFramePair(const synthetic::SyntheticSequence& sequence, int
   const SE3& world_from_ref = sequence.ground_truth[ref_index].world_from_cam;
   const SE3& world_from_cur = sequence.ground_truth[cur_index].world_from_cam;
   pair.cur_from_ref = world_from_cur.Inverse() * world_from_ref;
-  const SE3 ref_from_world = world_from_ref.Inverse();
-  for (const synthetic::Segment3d& edge : sequence.scene.edges()) {
-    pair.segments_in_ref.push_back(
-        {ref_from_world * edge.start_in_world, ref_from_world * edge.end_in_world});
-  }
+  pair.segments_in_ref = SegmentsInCam(sequence.scene, world_from_ref.Inverse());
   return pair;
 }
 
