@@ -16,7 +16,6 @@ PreparedFrame FramePreparer::Prepare(const cv::Mat& image) {
   frame.pyramid = ImagePyramid(image, num_levels_);
   frame.pyramid_ms = MsSince(start);
   if (frontend_ != nullptr) frame.lines = frontend_->Process(image);
-  frame.prepare_ms = MsSince(start);
   return frame;
 }
 

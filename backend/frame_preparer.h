@@ -19,7 +19,6 @@ struct PreparedFrame {
   ImagePyramid pyramid;
   LineFrame lines;  // no segments when odometry.use_lines is false
   double pyramid_ms = 0.0;
-  double prepare_ms = 0.0;  // all of Prepare (wall)
 };
 
 class FramePreparer {

@@ -136,6 +136,12 @@ OdometryFrameResult Odometry::ProcessFrame(int index, double timestamp, const cv
 OdometryFrameResult Odometry::ProcessFrame(int index, double timestamp, PreparedFrame frame,
                                            const cv::Mat& depth) {
   CheckImage(index, frame.image);
+  if (frame.pyramid.num_levels() != config_.odometry.num_levels) {
+    throw std::invalid_argument("Odometry::ProcessFrame: frame " + std::to_string(index) +
+                                " was prepared with " + std::to_string(frame.pyramid.num_levels()) +
+                                " pyramid levels, " + "odometry.num_levels is " +
+                                std::to_string(config_.odometry.num_levels));
+  }
   return ProcessPrepared(index, timestamp, std::move(frame), depth, WallClock::now());
 }
 

@@ -84,7 +84,8 @@ class Odometry {
                                    const cv::Mat& depth = cv::Mat());
   // The same with the per-image work already done (FramePreparer with this odometry's config,
   // e.g. on another thread); the result is identical, and tracking_thread_ms leaves out the
-  // preparation.
+  // preparation. Also throws std::invalid_argument when the pyramid's level count is not
+  // odometry.num_levels.
   OdometryFrameResult ProcessFrame(int index, double timestamp, PreparedFrame frame,
                                    const cv::Mat& depth = cv::Mat());
   // A frame that could not be loaded: kFailed with the extrapolated pose.

@@ -182,6 +182,13 @@ TEST(OdometryTest, FramesPreparedOnAnotherThreadGiveTheSameRun) {
   // A prepared frame of the wrong size is refused like an image.
   PreparedFrame small = preparer.Prepare(rendered.images[0].colRange(0, 64).clone());
   EXPECT_THROW(odometry.ProcessFrame(kRepeatFrames, 0.0, std::move(small)), std::invalid_argument);
+  // So is one prepared with another pyramid depth.
+  OdometryConfig other = config;
+  other.odometry.num_levels = config.odometry.num_levels - 1;
+  FramePreparer other_preparer(other);
+  EXPECT_THROW(
+      odometry.ProcessFrame(kRepeatFrames, 0.0, other_preparer.Prepare(rendered.images[0])),
+      std::invalid_argument);
 }
 
 TEST(OdometryTest, CompareSolverSolvesTheSameProblemsWithoutChangingTheRun) {
