@@ -9,6 +9,7 @@
 
 #include "core/synthetic/synthetic_internal.h"
 #include "core/synthetic/synthetic_sequence.h"
+#include "tests/small_lowtex_options.h"
 
 namespace pldvo::synthetic {
 namespace {
@@ -17,13 +18,11 @@ TEST(FrustumCullerTest, RaysThroughTheRectangleHitWhatTheWholeSceneGives) {
   internal::Rng rng(7);
   int culled_frames = 0, frames = 0;
   for (const int seed : {1, 2, 3}) {
-    SynthOptions options;
-    options.preset = "lowtex";
-    options.frames = 40;
+    SynthOptions options = test::SmallLowtexOptions(40);  // at half its size
     options.seed = seed;
-    options.width = 160;
-    options.height = 120;
-    options.fx = options.fy = 131.25;
+    options.width /= 2;
+    options.height /= 2;
+    options.fx = options.fy = options.fx / 2.0;
     const SyntheticSequence sequence = MakeSequence(options);
     const PinholeCamera& camera = sequence.camera;
     const FrustumCuller culler(sequence.scene, camera);
