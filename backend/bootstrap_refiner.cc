@@ -44,7 +44,7 @@ BootstrapRefinement RefineBootstrap(const Dataset& dataset, const OdometryConfig
   if (config.odometry.bootstrap_passes < 2) {
     throw std::invalid_argument("RefineBootstrap: odometry.bootstrap_passes must be >= 2");
   }
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = WallClock::now();
   OdometryConfig pass_config = config;
   pass_config.backend.edge_ba.enabled = false;
   pass_config.odometry.compare_solver = OdometryOptions::CompareSolver::kNone;

@@ -12,7 +12,6 @@
 #include "core/wall_clock.h"
 
 namespace pldvo {
-namespace {}  // namespace
 
 DepthMapper::DepthMapper(const PinholeCamera& camera, const MappingOptions& options)
     : camera_(camera), options_(options) {
@@ -160,7 +159,7 @@ FrameUpdateStats DepthMapper::UpdateWithFrame(const cv::Mat& image, const SE3& c
   if (!(cur_from_ref.translation().norm() > 0.0)) return stats;  // no baseline, no stereo
   // Two passes (edge pixels, then the rest) so that each is timed on its own.
   for (int pass = 0; pass < 2; ++pass) {
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = WallClock::now();
     for (int i = 0; i < map_.num_pixels(); ++i) {
       if (!map_.candidate(i) || (map_.edge_id(i) >= 0) != (pass == 0)) continue;
       if (map_.blacklist(i) >= options_.blacklist_threshold) continue;

@@ -57,7 +57,7 @@ double MappingWorker::Submit(MappingJob job) {
     };
     if (job.kind == MappingJob::Kind::kUpdate && pending_updates() >= max_pending_updates_) {
       if (wait_when_behind_) {
-        const auto start = std::chrono::steady_clock::now();
+        const auto start = WallClock::now();
         job_done_.wait(lock, [&] { return pending_updates() < max_pending_updates_; });
         wait_ms = MsSince(start);
       } else {
@@ -171,7 +171,7 @@ void MappingWorker::Publish(std::shared_ptr<KeyframeMap> keyframe_map) {
 }
 
 void MappingWorker::Run(const MappingJob& job) {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = WallClock::now();
   try {
     auto published = std::make_shared<KeyframeMap>();
     switch (job.kind) {

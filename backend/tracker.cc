@@ -131,7 +131,7 @@ TrackingResult Tracker::Track(const TrackingReference& reference, const ImagePyr
 
   double pose[kPoseAmbientSize];
   PoseToParameters(initial_cur_from_ref, pose);
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = WallClock::now();
   TrackingResult result;
   result.initial_cur_from_ref = initial_cur_from_ref;
   for (int level = coarsest; level >= options_.finest_level; --level) {

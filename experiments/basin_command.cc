@@ -156,7 +156,7 @@ int RunBasin(const CommandContext& context) {
       row.gt_translation = pair.cur_from_ref.translation().norm();
       row.gt_rotation = LogSO3(pair.cur_from_ref.rotation_matrix()).norm() * 180.0 / M_PI;
       for (int m = 0; m < kNumModes; ++m) {
-        const auto start = std::chrono::steady_clock::now();
+        const auto start = WallClock::now();
         const TrackingResult result = trackers[m].Track(reference, current, SE3());
         const double ms = MsSince(start);
         milliseconds[m] += ms;
