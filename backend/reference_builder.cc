@@ -51,7 +51,7 @@ struct MapSums {
     return static_cast<double>(map.idepth(i)) / static_cast<double>(map.idepth_var(i));
   }
   double weight(int i) const { return 1.0 / static_cast<double>(map.idepth_var(i)); }
-  int edge_id(int i) const { return map.edge_id(i) >= 0 ? map.edge_id(i) : -1; }
+  int edge_id(int i) const { return map.edge_id(i); }  // -1: on no edge
   double edge_weight(int i) const { return map.edge_id(i) >= 0 ? weight(i) : 0.0; }
 };
 

@@ -136,7 +136,7 @@ LoadedFrame LoadFrame(const Dataset& dataset, int index, FramePreparer* preparer
     try {
       loaded.prepared = preparer->Prepare(image);
     } catch (const std::exception&) {
-      loaded.prepared.reset();  // ProcessFrame(image) repeats the work and reports the failure
+      // Left unprepared: ProcessFrame(image) repeats the work and reports the failure.
     }
   }
   return loaded;
