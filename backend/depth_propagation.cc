@@ -50,7 +50,7 @@ SemiDenseDepthMap PropagateDepthMap(const SemiDenseDepthMap& old_map,
         continue;
       }
       const double intensity_old = old_keyframe.level(0).ptr<float>(y)[3 * x];
-      const double intensity_new = new_keyframe.Sample(0, pixel.x(), pixel.y())[0];
+      const double intensity_new = new_keyframe.SampleIntensity(0, pixel.x(), pixel.y());
       if (std::abs(intensity_new - intensity_old) > options.max_propagation_intensity_diff) {
         ++s.dropped_intensity;
         continue;

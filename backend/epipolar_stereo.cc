@@ -100,7 +100,7 @@ StereoStatus MakeEpipolarPatch(const ImagePyramid& keyframe, const EpipolarGeome
   }
   for (int j = -2; j <= 2; ++j) {
     const Eigen::Vector2d p = pixel_in_ref + j * dir;
-    patch->ref[j + 2] = keyframe.Sample(0, p.x(), p.y())[0];
+    patch->ref[j + 2] = keyframe.SampleIntensity(0, p.x(), p.y());
   }
   Eigen::Vector2d p0, p1;
   if (!geometry.Project(pixel_in_ref, idepth_centre, &p0) ||
@@ -125,7 +125,7 @@ double PatchSsd(const ImagePyramid& current, const EpipolarPatch& patch,
   double ssd = 0.0;
   for (int j = -2; j <= 2; ++j) {
     const Eigen::Vector2d p = pixel_in_cur + j * patch.step_cur;
-    const double r = current.Sample(0, p.x(), p.y())[0] - patch.ref[j + 2];
+    const double r = current.SampleIntensity(0, p.x(), p.y()) - patch.ref[j + 2];
     ssd += r * r;
   }
   return ssd;
@@ -143,7 +143,7 @@ double PhotometricDisparityVar(const ImagePyramid& current, const EpipolarPatch&
   for (int j = -2; j <= 2; ++j) {
     const Eigen::Vector2d p = pixel_in_cur + j * patch.step_cur;
     if (!current.CanSample(0, p.x(), p.y())) return kInf;
-    samples[j + 2] = current.Sample(0, p.x(), p.y())[0];
+    samples[j + 2] = current.SampleIntensity(0, p.x(), p.y());
   }
   const double step_sq = patch.step_cur.squaredNorm();
   double grad_sq = 0.0;

@@ -236,7 +236,7 @@ int AddGroundTruthEdges(const cv::Mat& image, const cv::Mat& depth,
         point.pixel = pixel;
         point.idepth = 1.0 / point_in_ref.z();
         point.idepth_var = options.idepth_var;
-        point.intensity = pyramid.Sample(level, pixel.x(), pixel.y())[0];
+        point.intensity = pyramid.SampleIntensity(level, pixel.x(), pixel.y());
         point.edge_id = edge_id;
         point.pixel_on_edge = pixel;  // sampled on the projected edge
         out.points.push_back(point);

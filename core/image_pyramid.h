@@ -45,6 +45,19 @@ class ImagePyramid {
     const Eigen::Map<const Eigen::Vector3f> p00(row0), p01(row0 + 3), p10(row1), p11(row1 + 3);
     return (1.f - dy) * ((1.f - dx) * p00 + dx * p01) + dy * ((1.f - dx) * p10 + dx * p11);
   }
+  // Bilinear I alone at (x, y), from the intensity plane: Sample(level, x, y)[0] bit for bit at
+  // a third of the work (the stereo SSDs read intensities only). Requires CanSample(level, x, y).
+  float SampleIntensity(int level, double x, double y) const {
+    const cv::Mat& plane = intensity_levels_[level];
+    const int ix = static_cast<int>(x);
+    const int iy = static_cast<int>(y);
+    const float dx = static_cast<float>(x - ix);
+    const float dy = static_cast<float>(y - iy);
+    const float* row0 = plane.ptr<float>(iy) + ix;
+    const float* row1 = plane.ptr<float>(iy + 1) + ix;
+    return (1.f - dy) * ((1.f - dx) * row0[0] + dx * row0[1]) +
+           dy * ((1.f - dx) * row1[0] + dx * row1[1]);
+  }
 
  private:
   std::vector<cv::Mat> levels_;

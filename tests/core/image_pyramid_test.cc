@@ -55,6 +55,22 @@ TEST(ImagePyramid, IntensityPlaneIsContiguousAndEqualsChannelZero) {
   }
 }
 
+TEST(ImagePyramid, SampleIntensityIsSampleChannelZeroBitForBit) {
+  cv::Mat noise(48, 64, CV_32F);
+  cv::randu(noise, 0.0, 255.0);
+  const ImagePyramid pyramid(noise, 3);
+  cv::RNG rng(7);
+  for (int level = 0; level < pyramid.num_levels(); ++level) {
+    for (int i = 0; i < 500; ++i) {
+      const double x = rng.uniform(0.0, pyramid.width(level) - 1.0);
+      const double y = rng.uniform(0.0, pyramid.height(level) - 1.0);
+      ASSERT_TRUE(pyramid.CanSample(level, x, y));
+      EXPECT_EQ(pyramid.SampleIntensity(level, x, y), pyramid.Sample(level, x, y)[0])
+          << level << " " << x << " " << y;
+    }
+  }
+}
+
 TEST(ImagePyramid, CanSampleGuardsTheBorder) {
   const ImagePyramid pyramid(cv::Mat(10, 20, CV_8U, cv::Scalar(0)), 1);
   EXPECT_TRUE(pyramid.CanSample(0, 0.0, 0.0));
