@@ -40,7 +40,8 @@ const Fixture& GetFixture() {
         synthetic_pairs::SegmentsInCam(sequence.scene, world_from_ref.Inverse()), keyframe.depth,
         sequence.camera, GroundTruthEdgeOptions());
     const MappingOptions options;
-    auto* f = new Fixture{sequence.camera, options, DepthMapper(sequence.camera, options)};
+    auto* f = new Fixture{
+        sequence.camera, options, DepthMapper(sequence.camera, options), {}, {}, {}, {}};
     f->mapper.InitializeKeyframe(keyframe.image, edges.trace);
     for (int k = 1; k <= kWarmupFrames + 1; ++k) {
       const int index = kKeyframe + k * kStride;

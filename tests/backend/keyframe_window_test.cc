@@ -73,7 +73,9 @@ TEST(KeyframeWindowTest, CentrePixelsAndAssociationFromMatches) {
   EXPECT_EQ(o.pixels.back(), Eigen::Vector2d(49.0, 100.0));
   for (size_t i = 0; i < o.pixels.size(); ++i) {
     EXPECT_EQ(o.pixels[i].y(), 100.0);
-    if (i > 0) EXPECT_GT(o.pixels[i].x(), o.pixels[i - 1].x());
+    if (i > 0) {
+      EXPECT_GT(o.pixels[i].x(), o.pixels[i - 1].x());
+    }
   }
   EXPECT_TRUE(snapshot.lines.empty());  // nothing refined yet: the BA triangulates
 }
