@@ -3,7 +3,8 @@
 // vs photometric stereo on edge pixels, the 3D line regularisation, NEES and propagation.
 // Measured values at this config (pldvo mapeval with the same --set keys) are quoted next to each
 // tolerance; the tolerances leave ~2x margin on them and sit far from what a broken stage gives
-// (the random initialisation has a median relative error of ~60%).
+// (the random initialisation has a median relative error of ~60%). The TESTs reading Result()
+// share one evaluation: ctest runs this binary as one process (ONE_PROCESS, tests/CMakeLists.txt).
 #include <gtest/gtest.h>
 
 #include <utility>
