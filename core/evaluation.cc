@@ -87,6 +87,7 @@ Sim3Alignment AlignUmeyama(const std::vector<Eigen::Vector3d>& src,
 std::string EvaluationOptions::Check() const {
   if (!(max_time_diff >= 0.0)) return "max_time_diff must be >= 0";
   if (!(rpe_delta > 0.0)) return "rpe_delta must be > 0";
+  if (!(scale_window > 0.0)) return "scale_window must be > 0";
   return "";
 }
 
@@ -175,6 +176,29 @@ EvaluationResult EvaluateTrajectory(const Trajectory& ground_truth, const Trajec
   } else {
     result.rpe_cm_s = std::numeric_limits<double>::quiet_NaN();
     result.rpe_deg_s = std::numeric_limits<double>::quiet_NaN();
+  }
+
+  // Scale per window: path lengths over the steps between consecutive associated poses.
+  const double start = estimate[matches.front().first].timestamp;
+  std::vector<double> est_length, gt_length;
+  for (size_t m = 1; m < matches.size(); ++m) {
+    const double t = estimate[matches[m - 1].first].timestamp;
+    const size_t window = static_cast<size_t>((t - start) / options.scale_window);
+    if (window >= est_length.size()) {
+      est_length.resize(window + 1, 0.0);
+      gt_length.resize(window + 1, 0.0);
+    }
+    est_length[window] += (est_positions[m] - est_positions[m - 1]).norm();
+    gt_length[window] += (gt_positions[m] - gt_positions[m - 1]).norm();
+  }
+  for (size_t w = 0; w < est_length.size(); ++w) {
+    if (gt_length[w] > 0.0) result.window_scales.push_back(est_length[w] / gt_length[w]);
+  }
+  if (!result.window_scales.empty()) {
+    const auto [lowest, highest] =
+        std::minmax_element(result.window_scales.begin(), result.window_scales.end());
+    result.scale_drift =
+        *lowest > 0.0 ? *highest / *lowest : std::numeric_limits<double>::infinity();
   }
 
   // Coverage: associated poses times the estimate's frame interval over the ground-truth span.

@@ -41,6 +41,8 @@ struct EvaluationOptions {
   double rpe_delta = 1.0;
   // Sim(3) alignment (monocular, scale unknown); false aligns with SE(3) and reports scale 1.
   bool align_scale = true;
+  // Length of the windows of the scale drift (window_scales), seconds.
+  double scale_window = 1.0;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
@@ -49,6 +51,8 @@ struct EvaluationOptions {
     v.Field("rpe_delta", &rpe_delta, "RPE interval in seconds (errors are reported per second).");
     v.Field("align_scale", &align_scale,
             "Align with Sim(3) (true, monocular) or SE(3) (false) before ATE and RPE.");
+    v.Field("scale_window", &scale_window,
+            "Window (s) of the local scale: estimated over ground-truth path length.");
   }
   // "" when valid, otherwise what is wrong.
   std::string Check() const;
@@ -67,6 +71,13 @@ struct EvaluationResult {
   // Fraction of the ground-truth time span covered by associated estimate poses, in [0, 1]:
   // num_associated * dt / (gt_span + dt), dt the median interval between estimate poses.
   double coverage = 0.0;
+  // Scale drift of a monocular estimate: per window of scale_window seconds (by the time of a
+  // step's first pose), the estimate's path length over the ground truth's, both summed over the
+  // steps between consecutive associated poses (estimate units per metre; 1 / scale where the
+  // scale is that of the alignment). Windows in which the ground truth does not move are left
+  // out. scale_drift = max / min of window_scales (1: no drift; 0 without windows).
+  std::vector<double> window_scales;
+  double scale_drift = 0.0;
   int num_pairs = 0;       // RPE pairs
   int num_associated = 0;  // estimate poses associated with ground truth
   Sim3Alignment gt_from_est;

@@ -268,7 +268,7 @@ int RunAblate(const CommandContext& context) {
   {
     std::ofstream csv(out + "/results.csv");
     csv << "dataset,config,status,frames,tracked,keyframes,lost_events,rpe_cm_s,rpe_deg_s,ate_m,"
-           "coverage,ms_median_tracking_thread,ms_median_total,init_seed,dir\n";
+           "coverage,scale_drift,ms_median_tracking_thread,ms_median_total,init_seed,dir\n";
     for (const Pair& pair : pairs) {
       const nlohmann::json& s = summaries[pair.index];
       auto integer = [&](const char* key) {
@@ -282,9 +282,10 @@ int RunAblate(const CommandContext& context) {
           << integer("keyframes") << "," << integer("lost_events") << ","
           << Fixed(JsonNumber(s, "rpe_cm_s"), 4) << "," << Fixed(JsonNumber(s, "rpe_deg_s"), 4)
           << "," << Fixed(JsonNumber(s, "ate_m"), 5) << "," << Fixed(JsonNumber(s, "coverage"), 3)
-          << "," << Fixed(JsonNumber(ms, "tracking_thread"), 2) << ","
-          << Fixed(JsonNumber(ms, "total"), 2) << ","
-          << (repeats > 1 ? std::to_string(pair.repeat) : std::string()) << "," << pair.dir << "\n";
+          << "," << Fixed(JsonNumber(s, "scale_drift"), 3) << ","
+          << Fixed(JsonNumber(ms, "tracking_thread"), 2) << "," << Fixed(JsonNumber(ms, "total"), 2)
+          << "," << (repeats > 1 ? std::to_string(pair.repeat) : std::string()) << "," << pair.dir
+          << "\n";
     }
   }
   {

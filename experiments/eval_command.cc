@@ -1,6 +1,6 @@
-// `pldvo eval --gt FILE --est FILE [--json]`: ATE, RPE and coverage of an estimated trajectory
-// against ground truth, both in TUM format (docs/evaluation.md). `--set key=value` sets the
-// EvaluationOptions (max_time_diff, rpe_delta, align_scale).
+// `pldvo eval --gt FILE --est FILE [--json]`: ATE, RPE, coverage and scale drift of an estimated
+// trajectory against ground truth, both in TUM format (docs/evaluation.md). `--set key=value`
+// sets the EvaluationOptions (max_time_diff, rpe_delta, align_scale, scale_window).
 #include <gflags/gflags.h>
 
 #include <cmath>
@@ -45,6 +45,8 @@ int RunEval(const CommandContext& context) {
       json["rpe_deg_s"] = NumberOrNull(result.rpe_deg_s);
       json["scale"] = result.scale;
       json["coverage"] = result.coverage;
+      json["scale_drift"] = NumberOrNull(result.scale_drift);
+      json["window_scales"] = result.window_scales;
       json["num_pairs"] = result.num_pairs;
       json["num_associated"] = result.num_associated;
       json["num_estimate"] = estimate.size();
@@ -60,7 +62,11 @@ int RunEval(const CommandContext& context) {
               << "scale (gt per est unit):   " << std::setprecision(6) << result.scale << "\n"
               << "coverage:                  " << std::setprecision(3) << result.coverage << "  ("
               << result.num_associated << " of " << estimate.size()
-              << " estimate poses associated, " << ground_truth.size() << " ground-truth poses)\n";
+              << " estimate poses associated, " << ground_truth.size() << " ground-truth poses)\n"
+              << "scale drift (max / min):   " << std::setprecision(3) << result.scale_drift
+              << "  (estimate units per gt metre, per " << options.scale_window << " s:";
+    for (double scale : result.window_scales) std::cout << " " << std::setprecision(3) << scale;
+    std::cout << ")\n";
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "pldvo eval: " << e.what() << "\n";

@@ -8,7 +8,8 @@
 //                        frame, flushed per line (a crash never loses what was written);
 //   OUT/timing.csv       one row per frame: status, counts and the time of every component;
 //   OUT/summary.json     at the end: counts, median / mean ms per component, and with ground
-//                        truth rpe_cm_s, rpe_deg_s, ate_m, coverage (Sim(3)-aligned);
+//                        truth rpe_cm_s, rpe_deg_s, ate_m, coverage (Sim(3)-aligned),
+//                        scale_drift and window_scales (1 s windows);
 //   OUT/trajectory_compare.txt  with odometry.compare_solver: the other solver's poses on the
 //                        same tracking problems (summary.json `compare_solver`);
 //   OUT/keyframe_maps.csv  with output.keyframe_map_error: each keyframe's map against the
@@ -196,7 +197,7 @@ int RunOdometryCommand(const CommandContext& context) {
   };
   trajectory_file << "# pldvo run: timestamp tx ty tz qx qy qz qw (world_from_cam), dataset "
                   << FLAGS_dataset << "\n";
-  timing_file << "index,timestamp,status,keyframe_id,lines,matches,reference_points,"
+  timing_file << "index,timestamp,status,keyframe_id,lines,matches,line_outliers,reference_points,"
                  "alternatives,iterations,final_rms,inlier_fraction";
   for (const char* key : kTimingKeys) timing_file << "," << key << "_ms";
   timing_file << "\n";
@@ -319,8 +320,8 @@ int RunOdometryCommand(const CommandContext& context) {
     if (result.status != FrameStatus::kFailed) rows.push_back(row);
     timing_file << i << "," << std::setprecision(17) << result.timestamp << ","
                 << FrameStatusName(result.status) << "," << result.keyframe_id << ","
-                << result.num_lines << "," << result.num_matches << ","
-                << result.num_reference_points << "," << result.alternatives_tried << ","
+                << result.num_lines << "," << result.num_matches << "," << result.num_line_outliers
+                << "," << result.num_reference_points << "," << result.alternatives_tried << ","
                 << result.tracking.TotalIterations() << "," << std::setprecision(6)
                 << result.tracking.final_rms << "," << result.tracking.inlier_fraction;
     for (double value : Values(row)) timing_file << "," << std::setprecision(4) << value;
@@ -389,6 +390,8 @@ int RunOdometryCommand(const CommandContext& context) {
       summary["ate_m"] = eval.ate_m;
       summary["coverage"] = eval.coverage;
       summary["scale"] = eval.scale;
+      summary["scale_drift"] = NumberOrNull(eval.scale_drift);
+      summary["window_scales"] = eval.window_scales;
       std::ostringstream line;
       line << std::fixed << std::setprecision(3) << "RPE " << eval.rpe_cm_s << " cm/s, "
            << eval.rpe_deg_s << " deg/s; ATE " << std::setprecision(4) << eval.ate_m

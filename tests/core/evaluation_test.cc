@@ -88,6 +88,36 @@ TEST(EvaluateTrajectory, HalfScaleEstimateHasScaleTwoAndZeroAte) {
   EXPECT_NEAR(result.rpe_deg_s, 0.0, kTolerance);
   EXPECT_EQ(result.num_associated, 100);
   EXPECT_NEAR(result.coverage, 1.0, kTolerance);
+  // 9.9 s of steps in 1 s windows, each at half the ground truth's length: no drift.
+  ASSERT_EQ(result.window_scales.size(), 10u);
+  for (double scale : result.window_scales) EXPECT_NEAR(scale, 0.5, kTolerance);
+  EXPECT_NEAR(result.scale_drift, 1.0, kTolerance);
+}
+
+TEST(EvaluateTrajectory, WindowScalesFollowAScaleDriftAndSkipWindowsWithoutMotion) {
+  // Ground truth at rest for the first second, then moving. The estimate repeats its steps at
+  // 0.5 of their length up to t = 5 s and at 0.25 after (a monocular scale that halves).
+  Trajectory gt = CurvedTrajectory(100);
+  for (int i = 0; i < 10; ++i) gt[i] = Pose(gt[i].timestamp, gt[10].world_from_cam.translation());
+  Trajectory est = {Pose(0.0, 0.5 * gt[0].world_from_cam.translation())};
+  for (int k = 0; k + 1 < 100; ++k) {
+    const double step_scale = k < 50 ? 0.5 : 0.25;
+    const Eigen::Vector3d step =
+        gt[k + 1].world_from_cam.translation() - gt[k].world_from_cam.translation();
+    est.push_back(
+        Pose(gt[k + 1].timestamp, est.back().world_from_cam.translation() + step_scale * step));
+  }
+  const EvaluationResult result = EvaluateTrajectory(gt, est);
+  // Window 0 (steps starting in [0, 1) s) has no ground-truth motion and is left out.
+  ASSERT_EQ(result.window_scales.size(), 9u);
+  for (int w = 0; w < 9; ++w) {
+    EXPECT_NEAR(result.window_scales[w], w + 1 < 5 ? 0.5 : 0.25, kTolerance) << "window " << w + 1;
+  }
+  EXPECT_NEAR(result.scale_drift, 2.0, kTolerance);
+
+  EvaluationOptions options;
+  options.scale_window = 0.0;
+  EXPECT_THROW(EvaluateTrajectory(gt, est, options), std::invalid_argument);
 }
 
 TEST(EvaluateTrajectory, OffsetAndRotatedEstimateHasZeroAte) {

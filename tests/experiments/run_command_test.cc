@@ -65,6 +65,22 @@ int Pldvo(const std::string& args, const fs::path& log) {
 
 const char* const kDeterministic = " --set odometry.parallel_mapping=false";
 
+// Rows of a CSV file with a header line, each split at commas.
+std::vector<std::vector<std::string>> CsvRows(const fs::path& path) {
+  std::vector<std::vector<std::string>> rows;
+  std::ifstream file(path);
+  std::string line;
+  std::getline(file, line);  // header
+  while (std::getline(file, line)) {
+    std::vector<std::string> fields;
+    std::stringstream stream(line);
+    std::string field;
+    while (std::getline(stream, field, ',')) fields.push_back(field);
+    rows.push_back(fields);
+  }
+  return rows;
+}
+
 TEST(RunCommandTest, WritesAllOutputs) {
   const fs::path out = TestRoot() / "run_all";
   ASSERT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " + out.string() +
@@ -76,8 +92,17 @@ TEST(RunCommandTest, WritesAllOutputs) {
   // trajectory.txt: one TUM line per tracked frame (all of them on this sequence).
   const Trajectory trajectory = ReadTrajectoryTum((out / "trajectory.txt").string());
   EXPECT_EQ(trajectory.size(), static_cast<size_t>(kFrames));
-  // timing.csv: a header and one row per frame.
+  // timing.csv: a header and one row per frame; the line gates unmatch at most the matches.
   EXPECT_EQ(CountLines(out / "timing.csv", false), kFrames + 1);
+  std::string header;
+  std::getline(std::ifstream(out / "timing.csv"), header);
+  EXPECT_EQ(header.rfind("index,timestamp,status,keyframe_id,lines,matches,line_outliers,", 0), 0u)
+      << header;
+  for (const std::vector<std::string>& row : CsvRows(out / "timing.csv")) {
+    ASSERT_GT(row.size(), 6u);
+    EXPECT_GE(std::stoi(row[6]), 0);
+    EXPECT_LE(std::stoi(row[6]), std::stoi(row[5])) << "frame " << row[0];
+  }
   // config.yaml: the effective config, loadable, with the override applied.
   OdometryConfig config;
   ASSERT_NO_THROW(LoadConfigYaml((out / "config.yaml").string(), &config));
@@ -95,9 +120,12 @@ TEST(RunCommandTest, WritesAllOutputs) {
       EXPECT_GE(summary[object][key].get<double>(), 0.0);
     }
   }
-  for (const char* key : {"rpe_cm_s", "rpe_deg_s", "ate_m", "coverage"}) {
+  for (const char* key : {"rpe_cm_s", "rpe_deg_s", "ate_m", "coverage", "scale_drift"}) {
     EXPECT_TRUE(summary[key].is_number()) << key;
   }
+  ASSERT_TRUE(summary["window_scales"].is_array());
+  EXPECT_FALSE(summary["window_scales"].empty());
+  EXPECT_GE(summary["scale_drift"].get<double>(), 1.0);
   // Coverage: all frames; timestamps in rgb.txt carry 6 decimals, hence not exactly 1.
   EXPECT_NEAR(summary["coverage"].get<double>(), 1.0, 1e-3);
   // Optional outputs: keyframe PNG and PLY, iteration images of frames 10 and 20.
@@ -166,22 +194,6 @@ TEST(RunCommandTest, FrontendThreadGivesTheSameTrajectory) {
     EXPECT_GT(summary["ms_median"]["detection"].get<double>(), 0.0);
   }
   EXPECT_EQ(trajectories[1], trajectories[0]);
-}
-
-// Rows of a CSV file with a header line, each split at commas.
-std::vector<std::vector<std::string>> CsvRows(const fs::path& path) {
-  std::vector<std::vector<std::string>> rows;
-  std::ifstream file(path);
-  std::string line;
-  std::getline(file, line);  // header
-  while (std::getline(file, line)) {
-    std::vector<std::string> fields;
-    std::stringstream stream(line);
-    std::string field;
-    while (std::getline(stream, field, ',')) fields.push_back(field);
-    rows.push_back(fields);
-  }
-  return rows;
 }
 
 // output.keyframe_map_error: every keyframe's map against the rendered depth. From the GT depth
@@ -334,6 +346,11 @@ TEST(AblateCommandTest, TinyGridWritesTablesAndPlot) {
   const std::string csv = Slurp(out / "results.csv");
   EXPECT_NE(csv.find("lowtex,sdvo,ok,"), std::string::npos) << csv;
   EXPECT_NE(csv.find("lowtex,points_lines,ok,"), std::string::npos) << csv;
+  EXPECT_EQ(csv.rfind("dataset,config,status,frames,tracked,keyframes,lost_events,rpe_cm_s,"
+                      "rpe_deg_s,ate_m,coverage,scale_drift,",
+                      0),
+            0u)
+      << csv;
   // results.md: the RPE table with one row for the sequence and a column per config.
   const std::string md = Slurp(out / "results.md");
   EXPECT_NE(md.find("| sequence | sdvo | points_lines |"), std::string::npos) << md;
