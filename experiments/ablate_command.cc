@@ -354,6 +354,7 @@ int RunAblate(const CommandContext& context) {
     table("RPE translation (cm/s)", "rpe_cm_s", 2);
     table("RPE rotation (deg/s)", "rpe_deg_s", 3);
     table("ATE (m)", "ate_m", 4);
+    table("Scale drift (max / min of the estimate's scale over 1 s windows)", "scale_drift", 2);
     table("Median tracking-thread time per frame (ms)", "ms", 1);
   }
   // Trajectory plots.

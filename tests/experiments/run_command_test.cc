@@ -355,6 +355,7 @@ TEST(AblateCommandTest, TinyGridWritesTablesAndPlot) {
   const std::string md = Slurp(out / "results.md");
   EXPECT_NE(md.find("| sequence | sdvo | points_lines |"), std::string::npos) << md;
   EXPECT_NE(md.find("| lowtex |"), std::string::npos) << md;
+  EXPECT_NE(md.find("### Scale drift"), std::string::npos) << md;
   // The trajectory plot: an SVG with the ground truth and one polyline per config.
   const std::string svg = Slurp(out / "trajectories_lowtex.svg");
   EXPECT_EQ(svg.rfind("<svg", 0), 0u);
