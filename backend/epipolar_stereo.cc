@@ -181,8 +181,13 @@ StereoStatus SearchEpipolarSsd(const ImagePyramid& current, const EpipolarGeomet
     start = 0.5 * (p_far + p_near) - 0.5 * options.min_search_length_px * direction;
     length = options.min_search_length_px;
   }
-  const int num_steps = static_cast<int>(std::floor(length)) + 1;
-  // The SSD at every 1-px step; small fixed buffer (max_search_length_px bounds it).
+  // Steps of ssd_search_step_px; the uniqueness test and the ambiguity spread leave out the
+  // steps within 2 px of the best.
+  const double step_px = options.ssd_search_step_px;
+  direction *= step_px;
+  const int near_best = static_cast<int>(std::lround(2.0 / step_px));
+  const int num_steps = static_cast<int>(std::floor(length / step_px)) + 1;
+  // The SSD at every step; small fixed buffer (MappingOptions::Check bounds the step count).
   constexpr int kMaxSteps = 4096;
   if (num_steps > kMaxSteps) return StereoStatus::kSearchTooLong;
   double ssd[kMaxSteps];
@@ -195,7 +200,7 @@ StereoStatus SearchEpipolarSsd(const ImagePyramid& current, const EpipolarGeomet
   if (best < 0) return StereoStatus::kOutside;
   double second = kInf;
   for (int k = 0; k < num_steps; ++k) {
-    if (std::abs(k - best) > 2) second = std::min(second, ssd[k]);
+    if (std::abs(k - best) > near_best) second = std::min(second, ssd[k]);
   }
   if (std::sqrt(ssd[best] / 5.0) > options.max_ssd_rms) return StereoStatus::kLargeError;
   if (second < options.ssd_uniqueness_ratio * ssd[best]) return StereoStatus::kNotUnique;
@@ -225,9 +230,28 @@ StereoStatus SearchEpipolarSsd(const ImagePyramid& current, const EpipolarGeomet
   const double disparity_var = GeometricDisparityVar(patch, options.sigma_epipolar_px) +
                                PhotometricDisparityVar(current, patch, match, sigma_intensity);
   if (!std::isfinite(disparity_var)) return StereoStatus::kOutside;
+  double idepth_var = disparity_var / jacobian_sq;  // alpha^2 sigma_lambda^2
+  if (options.ssd_ambiguity_variance) {
+    // Each other local SSD minimum k is the match with likelihood ratio
+    // exp(-(SSD_k - SSD_best) / (4 sigma_I^2)) (difference of two images of noise sigma_I);
+    // the variance gets the weighted spread sum w_k (d_k - d)^2 / (1 + sum w_k).
+    const double inv_scale = 1.0 / (4.0 * sigma_intensity * sigma_intensity);
+    double weight_sum = 1.0, spread = 0.0;
+    for (int k = 1; k + 1 < num_steps; ++k) {
+      if (std::abs(k - best) <= near_best || ssd[k] > ssd[k - 1] || ssd[k] > ssd[k + 1]) continue;
+      const double w = std::exp(-(ssd[k] - ssd[best]) * inv_scale);
+      if (w < 1e-4) continue;
+      const double d_k =
+          geometry.IdepthFromCurPixel(pixel_in_ref, start + k * direction, direction);
+      if (!std::isfinite(d_k)) continue;
+      spread += w * (d_k - idepth) * (d_k - idepth);
+      weight_sum += w;
+    }
+    idepth_var += spread / weight_sum;
+  }
   observation->idepth = idepth;
   observation->disparity_var = disparity_var;
-  observation->idepth_var = disparity_var / jacobian_sq;  // alpha^2 sigma_lambda^2
+  observation->idepth_var = idepth_var;
   observation->pixel_in_cur = match;
   observation->ssd = residual_ssd;
   return StereoStatus::kOk;

@@ -22,6 +22,11 @@ std::string MappingOptions::Check() const {
   if (min_search_length_px < 0.0 || max_search_length_px <= min_search_length_px) {
     error << "min/max_search_length_px must satisfy 0 <= min < max; ";
   }
+  // SearchEpipolarSsd keeps the SSD of every step in a buffer of 4096.
+  if (!(ssd_search_step_px > 0.0 && ssd_search_step_px <= 1.0) ||
+      max_search_length_px / ssd_search_step_px >= 4095.0) {
+    error << "ssd_search_step_px must be in (0, 1] with max_search_length_px / step < 4095; ";
+  }
   if (min_gradient_epipolar_cos < 0.0 || min_gradient_epipolar_cos >= 1.0) {
     error << "min_gradient_epipolar_cos must be in [0, 1); ";
   }

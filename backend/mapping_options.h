@@ -48,6 +48,9 @@ struct MappingOptions {
   // Search segments shorter than this are extended symmetrically (a few candidates for the
   // sub-pixel parabola); longer than max_search_length_px are skipped for this frame.
   double min_search_length_px = 3.0;
+  // The SSD is evaluated every ssd_search_step_px along the epipolar line: half a pixel samples
+  // a texture up to the image's Nyquist frequency (docs/mapping.md, "Search step").
+  double ssd_search_step_px = 0.5;
   double max_search_length_px = 200.0;
   // |cos| of the angle between the keyframe gradient and the epipolar line below which the
   // geometric error is too large to search (Engel 2013: gradients orthogonal to the epipolar
@@ -57,6 +60,9 @@ struct MappingOptions {
   double max_ssd_rms = 20.0;
   // Uniqueness: the best SSD outside +-2 px of the minimum must exceed ratio * best.
   double ssd_uniqueness_ratio = 1.5;
+  // Add the spread of the search's other SSD minima, weighted by their likelihood, to the
+  // observation variance (docs/mapping.md, "Ambiguous matches").
+  bool ssd_ambiguity_variance = true;
   // A 1-px keyframe step along the epipolar line must map to [1/s, s] px in the current frame
   // (strong scale change breaks the equidistant sampling).
   double max_epipolar_scale = 2.0;
@@ -149,6 +155,8 @@ struct MappingOptions {
     v.Field("max_idepth", &max_idepth, "Upper inverse-depth bound, 1/m (default 5).");
     v.Field("min_search_length_px", &min_search_length_px,
             "Shorter search segments are extended to this, pixels (default 3).");
+    v.Field("ssd_search_step_px", &ssd_search_step_px,
+            "Step of the SSD search along the epipolar line, pixels (default 0.5).");
     v.Field("max_search_length_px", &max_search_length_px,
             "Longer search segments are skipped, pixels (default 200).");
     v.Field("min_gradient_epipolar_cos", &min_gradient_epipolar_cos,
@@ -156,6 +164,8 @@ struct MappingOptions {
     v.Field("max_ssd_rms", &max_ssd_rms, "Maximum RMS of the best SSD, gray levels (default 20).");
     v.Field("ssd_uniqueness_ratio", &ssd_uniqueness_ratio,
             "Second-best SSD (> 2 px away) must exceed ratio * best (default 1.5).");
+    v.Field("ssd_ambiguity_variance", &ssd_ambiguity_variance,
+            "Add the weighted spread of the other SSD minima to the variance (default true).");
     v.Field("max_epipolar_scale", &max_epipolar_scale,
             "Maximum scale change along the epipolar line (default 2).");
     v.Field("use_line_stereo", &use_line_stereo, "Line-guided stereo on matched edges.");
