@@ -7,6 +7,7 @@
 // share one evaluation: ctest runs this binary as one process (ONE_PROCESS, tests/CMakeLists.txt).
 #include <gtest/gtest.h>
 
+#include <string>
 #include <utility>
 
 #include "experiments/mapping_evaluation.h"
@@ -25,6 +26,16 @@ MapEvalConfig SmallConfig() {
   config.frame_stride = 3;
   config.line_sigma_px = 0.25;
   config.line_sigma_sweep = {0.1};
+  return config;
+}
+
+// `pldvo mapeval --set synth.preset=P --set synth.seed=S --set line_sigma_sweep=[]` (320x240).
+MapEvalConfig SequenceConfig(const std::string& preset, int seed) {
+  MapEvalConfig config;
+  config.synth.preset = preset;
+  config.synth.seed = seed;
+  config.synth.threads = 2;
+  config.line_sigma_sweep = {};
   return config;
 }
 
@@ -128,11 +139,7 @@ TEST(DepthMapperTest, CorrelatedFusionReducesGrossErrorsOnLowTexture) {
   // the bulk within [0.5, 2.5], and no accuracy lost (5% slack on the relative error). Two
   // mapeval runs, ~3 s. The remaining gross
   // pixels are mostly wrong matches (docs/mapping.md), which no variance model makes consistent.
-  MapEvalConfig config;
-  config.synth.preset = "lowtex";
-  config.synth.seed = 2;
-  config.synth.threads = 2;
-  config.line_sigma_sweep = {};
+  MapEvalConfig config = SequenceConfig("lowtex", 2);
   ASSERT_GT(config.mapping.stereo_error_correlation, 0.0);  // the default is the new model
   const MapEvalResult correlated = RunMapEvaluation(config);
   config.mapping.stereo_error_correlation = 0.0;
@@ -161,11 +168,7 @@ TEST(DepthMapperTest, HalfPixelStepsAndAmbiguityVarianceShrinkTheTextureTail) {
   // photometric 30.40 -> 9.17, line-guided 28.19 -> 6.44; gross fraction 2.51% -> 1.17% and
   // 2.70% -> 1.42%; median relative error 0.0038 -> 0.0035 and 0.0042 -> 0.0039. Required: the
   // mean NEES below 0.5x, the gross fraction below 0.7x, no accuracy lost (2% slack).
-  MapEvalConfig config;
-  config.synth.preset = "textured";
-  config.synth.seed = 2;
-  config.synth.threads = 2;
-  config.line_sigma_sweep = {};
+  MapEvalConfig config = SequenceConfig("textured", 2);
   ASSERT_EQ(config.mapping.ssd_search_step_px, 0.5);
   ASSERT_TRUE(config.mapping.ssd_ambiguity_variance);
   const MapEvalResult half = RunMapEvaluation(config);

@@ -55,6 +55,28 @@ PlanePair MakePlanePair(const PinholeCamera& camera, double plane_depth, uint64_
   return pair;
 }
 
+// Calls on_match(observation) for every pixel of a 2-px grid (x >= x_min, 10-px margins) whose
+// epipolar patch and SSD search over [idepth_min, idepth_max] succeed.
+template <class OnMatch>
+void SearchPlaneGrid(const PinholeCamera& camera, const PlanePair& pair,
+                     const MappingOptions& options, int x_min, double idepth_min, double idepth_max,
+                     OnMatch on_match) {
+  const ImagePyramid ref(pair.ref, 1), cur(pair.cur, 1);
+  const EpipolarGeometry geometry(camera, pair.cur_from_ref);
+  for (int y = 10; y < camera.height - 10; y += 2) {
+    for (int x = x_min; x < camera.width - 10; x += 2) {
+      const Eigen::Vector2d pixel(x, y);
+      EpipolarPatch patch;
+      StereoObservation observation;
+      if (MakeEpipolarPatch(ref, geometry, pixel, 0.5, options, &patch) == StereoStatus::kOk &&
+          SearchEpipolarSsd(cur, geometry, patch, pixel, idepth_min, idepth_max, options,
+                            &observation) == StereoStatus::kOk) {
+        on_match(observation);
+      }
+    }
+  }
+}
+
 TEST(SemiDenseDepthMapTest, FuseIsProductOfGaussians) {
   SemiDenseDepthMap map(4, 4);
   MappingOptions options;
@@ -254,29 +276,18 @@ TEST(EpipolarStereoTest, SsdSearchRejectsAnIntervalThatLeavesTheImage) {
 TEST(EpipolarStereoTest, ResidualScaledNoiseKeepsTheObservationVarianceConsistent) {
   const PinholeCamera camera = TestCamera();
   const PlanePair pair = MakePlanePair(camera, 2.0, 5, 4.0);
-  const ImagePyramid ref(pair.ref, 1), cur(pair.cur, 1);
-  const EpipolarGeometry geometry(camera, pair.cur_from_ref);
   auto within_2_sigma = [&](bool residual_noise, int* count) {
     MappingOptions options;
     options.sigma_intensity = 1.0;
     options.sigma_epipolar_px = 0.05;
     options.residual_intensity_noise = residual_noise;
+    options.ssd_ambiguity_variance = false;  // the noise model alone
     int found = 0, within = 0;
-    for (int y = 10; y < camera.height - 10; y += 2) {
-      for (int x = 20; x < camera.width - 10; x += 2) {
-        const Eigen::Vector2d pixel(x, y);
-        EpipolarPatch patch;
-        StereoObservation observation;
-        if (MakeEpipolarPatch(ref, geometry, pixel, 0.5, options, &patch) != StereoStatus::kOk ||
-            SearchEpipolarSsd(cur, geometry, patch, pixel, 0.3, 0.7, options, &observation) !=
-                StereoStatus::kOk) {
-          continue;
-        }
-        ++found;
-        const double error = observation.idepth - 0.5;
-        within += error * error <= 4.0 * observation.idepth_var;
-      }
-    }
+    SearchPlaneGrid(camera, pair, options, 20, 0.3, 0.7, [&](const StereoObservation& obs) {
+      ++found;
+      const double error = obs.idepth - 0.5;
+      within += error * error <= 4.0 * obs.idepth_var;
+    });
     *count = found;
     return static_cast<double>(within) / found;
   };
@@ -306,22 +317,10 @@ SearchCount SearchAFineTextureAtHalfPixelDisparities(double step_px) {
   for (const double shift : {5.5, 6.5, 7.5, 8.5}) {
     const PlanePair pair =
         MakePlanePair(camera, camera.fx * 0.1 / shift, 3, 1.0, /*blur_sigma=*/0.7);
-    const ImagePyramid ref(pair.ref, 1), cur(pair.cur, 1);
-    const EpipolarGeometry geometry(camera, pair.cur_from_ref);
-    for (int y = 10; y < camera.height - 10; y += 2) {
-      for (int x = 40; x < camera.width - 10; x += 2) {
-        const Eigen::Vector2d pixel(x, y);
-        EpipolarPatch patch;
-        StereoObservation observation;
-        if (MakeEpipolarPatch(ref, geometry, pixel, 0.5, options, &patch) != StereoStatus::kOk ||
-            SearchEpipolarSsd(cur, geometry, patch, pixel, 0.0, 2.0, options, &observation) !=
-                StereoStatus::kOk) {
-          continue;
-        }
-        ++count.found;
-        count.gross += std::abs(observation.idepth * camera.fx * 0.1 - shift) > 1.0;
-      }
-    }
+    SearchPlaneGrid(camera, pair, options, 40, 0.0, 2.0, [&](const StereoObservation& obs) {
+      ++count.found;
+      count.gross += std::abs(obs.idepth * camera.fx * 0.1 - shift) > 1.0;
+    });
   }
   std::printf("step %.1f px: %d matches, %.4f gross\n", step_px, count.found,
               static_cast<double>(count.gross) / count.found);
