@@ -90,6 +90,7 @@ std::string MapEvalConfig::Check() const {
   if (keyframe_index < 0) return "keyframe_index must be >= 0";
   if (num_frames < 1) return "num_frames must be >= 1";
   if (frame_stride < 1) return "frame_stride must be >= 1";
+  if (speed_repetitions < 0) return "speed_repetitions must be >= 0";
   if (line_sigma_px < 0.0) return "line_sigma_px must be >= 0";
   if (!(discontinuity_rel_step > 0.0)) return "discontinuity_rel_step must be > 0";
   if (discontinuity_radius_px < 0) return "discontinuity_radius_px must be >= 0";
@@ -136,7 +137,7 @@ MapEvalResult RunMapEvaluation(const MapEvalConfig& config) {
 
   // Edge stereo speed with wide priors: one update of the random initialisation with the last
   // frame.
-  {
+  if (config.speed_repetitions > 0) {
     const SE3 cur_from_ref = frames.back().world_from_cam.Inverse() * keyframe.world_from_cam;
     const std::vector<MatchedLine> lines = ProjectGroundTruthLines(
         gt_edges, sequence.camera, cur_from_ref, config.line_sigma_px, config.line_seed);
@@ -144,7 +145,7 @@ MapEvalResult RunMapEvaluation(const MapEvalConfig& config) {
       MappingOptions options = config.mapping;
       options.use_line_stereo = variant == 1;
       double best = 1e30;
-      for (int repetition = 0; repetition < 5; ++repetition) {
+      for (int repetition = 0; repetition < config.speed_repetitions; ++repetition) {
         DepthMapper mapper(sequence.camera, options);
         mapper.InitializeKeyframe(keyframe.image, gt_edges.trace);
         const FrameUpdateStats stats =
@@ -257,11 +258,13 @@ std::string FormatMapEvalTable(const MapEvalResult& r) {
                   run.line_stats.pixels_rejected);
     out << line;
   }
-  std::snprintf(line, sizeof(line),
-                "edge stereo with wide priors (random init vs the last frame): photometric SSD "
-                "%.2f us/px, line-guided %.2f us/px\n",
-                r.wide_prior_photometric_us, r.wide_prior_line_us);
-  out << line;
+  if (r.wide_prior_photometric_us > 0.0) {
+    std::snprintf(line, sizeof(line),
+                  "edge stereo with wide priors (random init vs the last frame): photometric SSD "
+                  "%.2f us/px, line-guided %.2f us/px\n",
+                  r.wide_prior_photometric_us, r.wide_prior_line_us);
+    out << line;
+  }
   std::snprintf(line, sizeof(line),
                 "propagated to the last frame: %d hypotheses, %d evaluated, rel. err %.4f, "
                 "mean NEES %.2f, median NEES %.3f\n",

@@ -27,6 +27,8 @@ struct MapEvalConfig {
   // Further line-guided runs, one per endpoint noise (the accuracy crossover with photometric).
   std::vector<double> line_sigma_sweep = {0.1, 0.5, 1.0};
   int line_seed = 17;
+  // Best of this many timings of the edge stereo with wide priors (0 skips the timing).
+  int speed_repetitions = 5;
   // ContinuousDepthMask: a GT inverse-depth step larger than this fraction between 4-neighbours
   // is a discontinuity; pixels within discontinuity_radius_px of one are left out of
   // `continuous` (3 = the 5-sample SSD's half-length plus the bilinear interpolation pixel).
@@ -47,6 +49,8 @@ struct MapEvalConfig {
     v.Field("frame_stride", &frame_stride, "Frame k is keyframe_index + k * frame_stride.");
     v.Field("line_sigma_px", &line_sigma_px, "Endpoint noise of the GT current lines, pixels.");
     v.Field("line_seed", &line_seed, "Seed of that noise.");
+    v.Field("speed_repetitions", &speed_repetitions,
+            "Best of this many timings of the wide-prior edge stereo (0 skips it).");
     v.Field("discontinuity_rel_step", &discontinuity_rel_step,
             "GT inverse-depth step between neighbours that is a discontinuity (fraction).");
     v.Field("discontinuity_radius_px", &discontinuity_radius_px,
@@ -83,7 +87,7 @@ struct MapEvalResult {
   MapEvalRun line_guided;              // at config.line_sigma_px
   std::vector<MapEvalRun> line_sweep;  // at config.line_sigma_sweep
   // Edge-pixel stereo time from the random initialisation against the last frame (wide priors,
-  // one update; min over 5 repetitions), microseconds per edge pixel.
+  // one update; min over config.speed_repetitions, 0 when skipped), microseconds per edge pixel.
   double wide_prior_photometric_us = 0.0;
   double wide_prior_line_us = 0.0;
   DepthErrorStats propagated;  // line-guided map propagated to the last frame vs its GT depth

@@ -26,6 +26,7 @@ MapEvalConfig SmallConfig() {
   config.frame_stride = 3;
   config.line_sigma_px = 0.25;
   config.line_sigma_sweep = {0.1};
+  config.speed_repetitions = 0;  // timing belongs in `pldvo mapeval`, not in a test
   return config;
 }
 
@@ -36,6 +37,7 @@ MapEvalConfig SequenceConfig(const std::string& preset, int seed) {
   config.synth.seed = seed;
   config.synth.threads = 2;
   config.line_sigma_sweep = {};
+  config.speed_repetitions = 0;
   return config;
 }
 
