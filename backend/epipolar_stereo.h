@@ -109,12 +109,11 @@ struct StereoObservation {
 // options.ssd_search_step_px, parabola sub-pixel refinement), with the variance above; with
 // options.ssd_ambiguity_variance the variance also gets the spread of the other SSD minima,
 // sum_k w_k (d_k - d)^2 / (1 + sum_k w_k), w_k = exp(-(SSD_k - SSD_best) / (4 sigma_I^2)) the
-// likelihood ratio of minimum k against the best (docs/mapping.md, "Ambiguous matches").
-// Every step of the interval must be
-// sampled: when part of it leaves the current image the search returns kTruncated, because the
-// best of the remaining steps is then a wrong match whenever the true one lies outside (under
-// forward motion the bottom rows' matches leave the image first; docs/mapping.md, "Truncated
-// searches").
+// likelihood ratio of minimum k against the best (docs/mapping.md, "Search step and ambiguous
+// matches"). Every step of the interval must be sampled: when part of it leaves the current
+// image the search returns kTruncated, because the best of the remaining steps is then a wrong
+// match whenever the true one lies outside (under forward motion the bottom rows' matches leave
+// the image first; docs/mapping.md, "Truncated searches").
 StereoStatus SearchEpipolarSsd(const ImagePyramid& current, const EpipolarGeometry& geometry,
                                const EpipolarPatch& patch, const Eigen::Vector2d& pixel_in_ref,
                                double idepth_min, double idepth_max, const MappingOptions& options,

@@ -49,7 +49,8 @@ struct MappingOptions {
   // sub-pixel parabola); longer than max_search_length_px are skipped for this frame.
   double min_search_length_px = 3.0;
   // The SSD is evaluated every ssd_search_step_px along the epipolar line: half a pixel samples
-  // a texture up to the image's Nyquist frequency (docs/mapping.md, "Search step").
+  // a texture up to the image's Nyquist frequency (docs/mapping.md, "Search step and ambiguous
+  // matches").
   double ssd_search_step_px = 0.5;
   double max_search_length_px = 200.0;
   // |cos| of the angle between the keyframe gradient and the epipolar line below which the
@@ -61,7 +62,7 @@ struct MappingOptions {
   // Uniqueness: the best SSD outside +-2 px of the minimum must exceed ratio * best.
   double ssd_uniqueness_ratio = 1.5;
   // Add the spread of the search's other SSD minima, weighted by their likelihood, to the
-  // observation variance (docs/mapping.md, "Ambiguous matches").
+  // observation variance (docs/mapping.md, "Search step and ambiguous matches").
   bool ssd_ambiguity_variance = true;
   // A 1-px keyframe step along the epipolar line must map to [1/s, s] px in the current frame
   // (strong scale change breaks the equidistant sampling).
