@@ -35,7 +35,11 @@ std::vector<cv::line_descriptor::KeyLine> LbdDescriber::MakeKeyLines(
     kl.ePointInOctaveX = kl.endPointX * inv_scale;
     kl.ePointInOctaveY = kl.endPointY * inv_scale;
     kl.lineLength = static_cast<float>(s.length) * inv_scale;
+    // BinaryDescriptor samples numOfPixels steps of one octave pixel centred on the midpoint.
     kl.numOfPixels = std::max(2, static_cast<int>(std::lround(kl.lineLength)));
+    if (options_.max_support_px > 0) {
+      kl.numOfPixels = std::min(kl.numOfPixels, options_.max_support_px);
+    }
     kl.pt =
         cv::Point2f(0.5f * (kl.startPointX + kl.endPointX), 0.5f * (kl.startPointY + kl.endPointY));
     kl.size = std::abs((kl.endPointX - kl.startPointX) * (kl.endPointY - kl.startPointY));

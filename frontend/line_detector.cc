@@ -73,6 +73,7 @@ LineDetector::LineDetector(const LineDetectorOptions& options) : options_(option
       params.GradientThresholdValue = options_.edlines_gradient_threshold;
       params.MinLineLength = options_.edlines_min_line_length;
       params.LineFitErrorThreshold = options_.edlines_line_fit_error;
+      params.NFAValidation = options_.edlines_nfa_validation;
       edlines_->setParams(params);
       break;
     }

@@ -38,6 +38,9 @@ std::string LineMergerOptions::Check() const {
 std::string LineDescriptorOptions::Check() const {
   if (band_width < 1 || band_width > 20) return "descriptor.band_width must be in 1..20";
   if (min_octave < 0 || min_octave > 4) return "descriptor.min_octave must be in 0..4";
+  if (max_support_px != 0 && max_support_px < 2) {
+    return "descriptor.max_support_px must be 0 (whole segment) or >= 2";
+  }
   return "";
 }
 

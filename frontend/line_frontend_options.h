@@ -46,6 +46,10 @@ struct LineDetectorOptions {
   int edlines_gradient_threshold = 20;
   int edlines_min_line_length = 10;
   double edlines_line_fit_error = 1.0;
+  // EDLines' a-contrario validation (NFA) of every fitted line. Off saves a quarter of the
+  // detection time on textured frames, but the unvalidated texture lines cost odometry accuracy
+  // there (docs/line_frontend.md, "Cheaper detection and description").
+  bool edlines_nfa_validation = true;
   // FLD: minimum length (octave pixels), line-fit distance threshold and Canny thresholds.
   int fld_length_threshold = 10;
   double fld_distance_threshold = 1.414;
@@ -79,6 +83,8 @@ struct LineDetectorOptions {
             "EDLines minimum line length (octave px).");
     v.Field("edlines_line_fit_error", &edlines_line_fit_error,
             "EDLines line-fit error threshold (px).");
+    v.Field("edlines_nfa_validation", &edlines_nfa_validation,
+            "EDLines a-contrario (NFA) validation of fitted lines.");
     v.Field("fld_length_threshold", &fld_length_threshold, "FLD minimum length (octave px).");
     v.Field("fld_distance_threshold", &fld_distance_threshold,
             "FLD line-fit distance threshold (px).");
@@ -132,11 +138,18 @@ struct LineDescriptorOptions {
   // in full-resolution pixels, which on lowtex also raised the match recall (0.85 -> 0.90 at a
   // 10-frame gap, docs/line_frontend.md).
   int min_octave = 1;
+  // Length of the support region along the segment, in octave pixels, centred on its midpoint:
+  // min(segment length, max_support_px); 0 (default) = the whole segment. LBD's cost is
+  // proportional to it: 32 halves the description time on textured frames but costs lowtex
+  // matches (docs/line_frontend.md, "Cheaper detection and description").
+  int max_support_px = 0;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
     v.Field("band_width", &band_width, "LBD band width (octave px).");
     v.Field("min_octave", &min_octave, "Describe at octave max(detection octave, min_octave).");
+    v.Field("max_support_px", &max_support_px,
+            "LBD support length along the segment (octave px, centred; 0 = whole segment).");
   }
   std::string Check() const;
 };

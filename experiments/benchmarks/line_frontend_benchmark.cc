@@ -9,7 +9,7 @@
 //   Textured/<variant>        the whole pipeline on a `textured` frame (seed 3, frame 0; the
 //                             costliest frames of Table III), with the detect / merge /
 //                             describe milliseconds as counters: the defaults and the options
-//                             that trade lines for time (docs/line_frontend.md)
+//                             that trade accuracy for time (docs/line_frontend.md)
 // and, when /work/shared/data/kitti00_first200 exists (skipped otherwise), the whole frontend
 // over its 200 frames (1241x376): Kitti/<lsd|edlines> processes one frame per iteration and
 // matches it to the previous one; counters report lines (edges) per frame, detections per
@@ -241,11 +241,17 @@ void RegisterAll() {
   coarse_lbd.descriptor.min_octave = 2;
   LineFrontendOptions fewer_lines = defaults;
   fewer_lines.merger.max_segments = 100;
+  LineFrontendOptions no_nfa = defaults;
+  no_nfa.detector.edlines_nfa_validation = false;
+  LineFrontendOptions short_support = defaults;
+  short_support.descriptor.max_support_px = 32;
   for (const auto& [name, options] :
        {std::pair<const char*, LineFrontendOptions>{"Textured/default", defaults},
         {"Textured/num_octaves:1", one_octave},
         {"Textured/descriptor_min_octave:2", coarse_lbd},
-        {"Textured/max_segments:100", fewer_lines}}) {
+        {"Textured/max_segments:100", fewer_lines},
+        {"Textured/edlines_nfa_validation:0", no_nfa},
+        {"Textured/descriptor_max_support:32", short_support}}) {
     benchmark::RegisterBenchmark(name, BM_Textured, options)->Unit(benchmark::kMillisecond);
   }
   if (std::filesystem::is_directory(std::filesystem::path(kKittiDir) / "rgb")) {

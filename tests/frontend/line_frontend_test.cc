@@ -3,10 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <iostream>
 #include <map>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <set>
+
+#include "tests/random_texture.h"
 
 namespace pldvo {
 namespace {
@@ -75,6 +78,38 @@ TEST(LbdDescriber, KeyLinesFollowBinaryDescriptorConventions) {
   EXPECT_NEAR(keylines[1].angle, -M_PI / 2, 1e-6);
   EXPECT_EQ(keylines[0].octave, 0);
   EXPECT_FLOAT_EQ(keylines[0].endPointX, 110.f);
+}
+
+// max_support_px = C describes a segment longer than C by its central C octave pixels: the
+// descriptor equals that of the central piece of length C described whole, and differs from the
+// whole segment's on a textured image.
+TEST(LbdDescriber, MaxSupportDescribesTheCentralPartOfTheSegment) {
+  const cv::Mat texture = test::RandomTexture(cv::Size(640, 480), 3, 2.0);
+  LineDescriptorOptions capped;
+  capped.min_octave = 0;
+  capped.max_support_px = 40;
+  LineDescriptorOptions whole = capped;
+  whole.max_support_px = 0;
+  LbdDescriber capped_describer(capped);
+  LbdDescriber whole_describer(whole);
+  const std::vector<LineSegment> segment = {
+      MakeLineSegment({100, 200}, {300, 240}, 0, 0.5)};  // length 204, midpoint (200, 220)
+  const Eigen::Vector2d mid(200, 220);
+  const Eigen::Vector2d half = 20.0 * (segment[0].end - segment[0].start).normalized();
+  const std::vector<LineSegment> central = {MakeLineSegment(mid - half, mid + half, 0, 0.5)};
+  EXPECT_EQ(capped_describer.MakeKeyLines(segment, texture.size())[0].numOfPixels, 40);
+  const cv::Mat d_capped = capped_describer.Describe(texture, segment);
+  const cv::Mat d_central = whole_describer.Describe(texture, central);
+  const cv::Mat d_whole = whole_describer.Describe(texture, segment);
+  std::cout << "capped vs whole segment: Hamming "
+            << HammingDistance32(d_capped.ptr(0), d_whole.ptr(0)) << "\n";
+  EXPECT_EQ(HammingDistance32(d_capped.ptr(0), d_central.ptr(0)), 0);
+  EXPECT_GT(HammingDistance32(d_capped.ptr(0), d_whole.ptr(0)), 20);
+  // A segment shorter than the cap is described whole.
+  EXPECT_EQ(HammingDistance32(capped_describer.Describe(texture, central).ptr(0), d_central.ptr(0)),
+            0);
+  capped.max_support_px = 1;
+  EXPECT_THROW(LbdDescriber{capped}, std::invalid_argument);
 }
 
 // The image translated by (14.5, -9.25) px: every segment must match its translated self,
