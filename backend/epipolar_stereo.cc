@@ -181,20 +181,38 @@ StereoStatus SearchEpipolarSsd(const ImagePyramid& current, const EpipolarGeomet
     start = 0.5 * (p_far + p_near) - 0.5 * options.min_search_length_px * direction;
     length = options.min_search_length_px;
   }
-  // Steps of ssd_search_step_px; the uniqueness test and the ambiguity spread leave out the
-  // steps within 2 px of the best.
-  const double step_px = options.ssd_search_step_px;
+  // The step is the patch's sample spacing |step_cur| (which lies along the epipolar line)
+  // divided by n = round(|step_cur| / ssd_search_step_px): then sample j of step k is line
+  // sample k + j n (in the order of step_cur), and every line sample is interpolated once
+  // (Engel 2013 steps by the sample spacing, n = 1). The uniqueness test and the ambiguity
+  // spread leave out the steps within 2 px of the best.
+  const double spacing = patch.step_cur.norm();
+  const int n = std::max(1, static_cast<int>(std::lround(spacing / options.ssd_search_step_px)));
+  const int sample_stride = patch.step_cur.dot(direction) < 0.0 ? -n : n;
+  const double step_px = spacing / n;
   direction *= step_px;
   const int near_best = static_cast<int>(std::lround(2.0 / step_px));
   const int num_steps = static_cast<int>(std::floor(length / step_px)) + 1;
-  // The SSD at every step; small fixed buffer (MappingOptions::Check bounds the step count).
-  constexpr int kMaxSteps = 4096;
-  if (num_steps > kMaxSteps) return StereoStatus::kSearchTooLong;
-  double ssd[kMaxSteps];
+  // Small fixed buffers (MappingOptions::Check bounds the step count at unit spacing).
+  constexpr int kMaxSamples = 4352;
+  const int num_samples = num_steps + 4 * n;
+  if (num_samples > kMaxSamples) return StereoStatus::kSearchTooLong;
+  float samples[kMaxSamples];
+  for (int m = 0; m < num_samples; ++m) {
+    const Eigen::Vector2d p = start + (m - 2 * n) * direction;
+    if (!current.CanSample(0, p.x(), p.y())) return StereoStatus::kTruncated;
+    samples[m] = current.SampleIntensity(0, p.x(), p.y());
+  }
+  double ssd[kMaxSamples];
   int best = -1;
   for (int k = 0; k < num_steps; ++k) {
-    ssd[k] = PatchSsd(current, patch, start + k * direction);
-    if (!(ssd[k] < kInf)) return StereoStatus::kTruncated;
+    const float* centre = samples + k + 2 * n;
+    double sum = 0.0;
+    for (int j = -2; j <= 2; ++j) {
+      const double r = centre[j * sample_stride] - patch.ref[j + 2];
+      sum += r * r;
+    }
+    ssd[k] = sum;
     if (best < 0 || ssd[k] < ssd[best]) best = k;
   }
   if (best < 0) return StereoStatus::kOutside;

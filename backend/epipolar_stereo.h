@@ -106,7 +106,8 @@ struct StereoObservation {
 };
 
 // The exhaustive SSD search along x's epipolar line over [idepth_min, idepth_max] (steps of
-// options.ssd_search_step_px, parabola sub-pixel refinement), with the variance above; with
+// about options.ssd_search_step_px that divide the patch's sample spacing, each line sample
+// interpolated once; parabola sub-pixel refinement), with the variance above; with
 // options.ssd_ambiguity_variance the variance also gets the spread of the other SSD minima,
 // sum_k w_k (d_k - d)^2 / (1 + sum_k w_k), w_k = exp(-(SSD_k - SSD_best) / (4 sigma_I^2)) the
 // likelihood ratio of minimum k against the best (docs/mapping.md, "Search step and ambiguous

@@ -48,9 +48,10 @@ struct MappingOptions {
   // Search segments shorter than this are extended symmetrically (a few candidates for the
   // sub-pixel parabola); longer than max_search_length_px are skipped for this frame.
   double min_search_length_px = 3.0;
-  // The SSD is evaluated every ssd_search_step_px along the epipolar line: half a pixel samples
-  // a texture up to the image's Nyquist frequency (docs/mapping.md, "Search step and ambiguous
-  // matches").
+  // The SSD is evaluated about every ssd_search_step_px along the epipolar line: half a pixel
+  // samples a texture up to the image's Nyquist frequency (docs/mapping.md, "Search step and
+  // ambiguous matches"). The step is the patch's sample spacing in the current frame divided by
+  // the nearest integer to spacing / ssd_search_step_px, so that steps share their samples.
   double ssd_search_step_px = 0.5;
   double max_search_length_px = 200.0;
   // |cos| of the angle between the keyframe gradient and the epipolar line below which the
@@ -157,7 +158,8 @@ struct MappingOptions {
     v.Field("min_search_length_px", &min_search_length_px,
             "Shorter search segments are extended to this, pixels (default 3).");
     v.Field("ssd_search_step_px", &ssd_search_step_px,
-            "Step of the SSD search along the epipolar line, pixels (default 0.5).");
+            "Step of the SSD search along the epipolar line, about this many pixels: the "
+            "patch's sample spacing / round(spacing / step) (default 0.5).");
     v.Field("max_search_length_px", &max_search_length_px,
             "Longer search segments are skipped, pixels (default 200).");
     v.Field("min_gradient_epipolar_cos", &min_gradient_epipolar_cos,

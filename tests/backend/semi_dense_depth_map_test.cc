@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -12,10 +13,12 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "backend/depth_map_io.h"
 #include "backend/depth_propagation.h"
 #include "backend/epipolar_stereo.h"
+#include "tests/random_texture.h"
 
 namespace pldvo {
 namespace {
@@ -33,10 +36,9 @@ struct PlanePair {
 
 PlanePair MakePlanePair(const PinholeCamera& camera, double plane_depth, uint64_t seed,
                         double noise_sigma, double blur_sigma = 1.2) {
-  cv::Mat texture(camera.height + 60, camera.width + 60, CV_8U);
   cv::RNG rng(seed);
-  rng.fill(texture, cv::RNG::UNIFORM, 0, 255);
-  cv::GaussianBlur(texture, texture, cv::Size(5, 5), blur_sigma);
+  cv::Mat texture = test::RandomTexture(cv::Size(camera.width + 60, camera.height + 60), rng,
+                                        blur_sigma, cv::Size(5, 5));
   texture.convertTo(texture, CV_32F);
   PlanePair pair;
   pair.shift_px = camera.fx * 0.1 / plane_depth;
@@ -241,6 +243,76 @@ TEST(EpipolarStereoTest, SsdSearchFindsPlaneDepth) {
   EXPECT_GT(found, 60);
   // Random texture: a few ambiguous matches may remain; 90% must be within 3 sigma.
   EXPECT_GT(consistent, 0.9 * found);
+}
+
+// Forward and backward motion towards a fronto-parallel textured plane at 2 m: the current image
+// is the reference scaled about the principal point by 2 / (2 - t_z), so the patch's sample
+// spacing in the current frame is 1.33 or 0.87 px and the search steps are a third or a half of
+// it. Both scales must find the plane. The patch runs against the search direction here (as it
+// does whenever the point is in front of both cameras); the same patch reversed (samples in
+// the opposite order, step_cur negated) must give the identical observation.
+TEST(EpipolarStereoTest, SsdSearchFindsPlaneDepthUnderForwardAndBackwardMotion) {
+  const PinholeCamera camera = TestCamera();
+  cv::Mat texture =
+      test::RandomTexture(cv::Size(camera.width + 60, camera.height + 60), 11, 1.2, cv::Size(5, 5));
+  texture.convertTo(texture, CV_32F);
+  const cv::Mat ref_image = texture(cv::Rect(20, 20, camera.width, camera.height)).clone();
+  const ImagePyramid ref(ref_image, 1);
+  const MappingOptions options;
+  for (const double t_z : {0.5, -0.3}) {
+    const double scale = 2.0 / (2.0 - t_z);
+    // cur(x) = texture(20 + c + (x - c) / scale).
+    const cv::Mat warp =
+        (cv::Mat_<double>(2, 3) << 1.0 / scale, 0, 20 + camera.cx * (1 - 1 / scale), 0, 1.0 / scale,
+         20 + camera.cy * (1 - 1 / scale));
+    cv::Mat cur_image;
+    cv::warpAffine(texture, cur_image, warp, cv::Size(camera.width, camera.height),
+                   cv::INTER_LINEAR | cv::WARP_INVERSE_MAP);
+    const ImagePyramid cur(cur_image, 1);
+    const EpipolarGeometry geometry(camera,
+                                    SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, -t_z)));
+    int found = 0, consistent = 0, against = 0, reversed_equal = 0;
+    std::vector<double> errors;
+    for (int y = 6; y < camera.height - 6; y += 3) {
+      for (int x = 6; x < camera.width - 6; x += 3) {
+        const Eigen::Vector2d pixel(x, y);
+        if ((pixel - Eigen::Vector2d(camera.cx, camera.cy)).norm() < 30.0) continue;  // epipole
+        EpipolarPatch patch;
+        StereoObservation observation;
+        Eigen::Vector2d p_far, p_near;
+        if (MakeEpipolarPatch(ref, geometry, pixel, 0.5, options, &patch) != StereoStatus::kOk ||
+            SearchEpipolarSsd(cur, geometry, patch, pixel, 0.3, 0.7, options, &observation) !=
+                StereoStatus::kOk ||
+            !geometry.Project(pixel, 0.3, &p_far) || !geometry.Project(pixel, 0.7, &p_near)) {
+          continue;
+        }
+        ++found;
+        against += patch.step_cur.dot(p_near - p_far) < 0.0;
+        const double error = observation.idepth - 0.5;
+        consistent += error * error <= 9.0 * observation.idepth_var;
+        errors.push_back(std::abs(error) / 0.5);
+        EpipolarPatch reversed = patch;
+        std::reverse(std::begin(reversed.ref), std::end(reversed.ref));
+        reversed.step_cur = -patch.step_cur;
+        StereoObservation reversed_observation;
+        reversed_equal += SearchEpipolarSsd(cur, geometry, reversed, pixel, 0.3, 0.7, options,
+                                            &reversed_observation) == StereoStatus::kOk &&
+                          std::abs(reversed_observation.idepth - observation.idepth) < 1e-9 &&
+                          std::abs(reversed_observation.idepth_var - observation.idepth_var) <
+                              1e-9 * observation.idepth_var;
+      }
+    }
+    std::sort(errors.begin(), errors.end());
+    std::printf(
+        "t_z %+.1f: %d matches (%d against the search), %.3f within 3 sigma, median rel. "
+        "error %.4f\n",
+        t_z, found, against, static_cast<double>(consistent) / found, errors[errors.size() / 2]);
+    EXPECT_GT(found, 300);
+    EXPECT_EQ(against, found);
+    EXPECT_EQ(reversed_equal, found);
+    EXPECT_GT(consistent, 0.9 * found);
+    EXPECT_LT(errors[errors.size() / 2], 0.015);
+  }
 }
 
 // A search whose interval partly leaves the current image cannot tell a match: the true one of
