@@ -193,8 +193,9 @@ StereoStatus SearchEpipolarSsd(const ImagePyramid& current, const EpipolarGeomet
   direction *= step_px;
   const int near_best = static_cast<int>(std::lround(2.0 / step_px));
   const int num_steps = static_cast<int>(std::floor(length / step_px)) + 1;
-  // Small fixed buffers (MappingOptions::Check bounds the step count at unit spacing).
-  constexpr int kMaxSamples = 4352;
+  // Small fixed buffers: the steps plus the 2 n samples beyond each end. MappingOptions::Check
+  // bounds the count at the nominal step; a finer actual step can exceed it (kSearchTooLong).
+  constexpr int kMaxSamples = 4096 + 256;
   const int num_samples = num_steps + 4 * n;
   if (num_samples > kMaxSamples) return StereoStatus::kSearchTooLong;
   float samples[kMaxSamples];
