@@ -68,12 +68,14 @@ SemiDenseDepthMap PropagateDepthMap(const SemiDenseDepthMap& old_map,
           ++s.collisions_occluded;
           if (d1 > d_other) {
             new_map.Set(j, d1, v1, old_map.validity(i));
+            new_map.SetEvidence(j, old_map.inlier_evidence(i), old_map.outlier_evidence(i));
             if (old_map.num_observations(i) > 0) new_map.CountObservation(j);
           }
         }
         continue;
       }
       new_map.Set(j, d1, v1, old_map.validity(i));
+      new_map.SetEvidence(j, old_map.inlier_evidence(i), old_map.outlier_evidence(i));
       if (old_map.num_observations(i) > 0) new_map.CountObservation(j);  // stereo-based
       ++s.propagated;
     }

@@ -45,6 +45,10 @@ std::string MappingOptions::Check() const {
     error << "validity counters must satisfy initial > 0, increment >= 0, decrement > 0, "
              "max >= initial; ";
   }
+  if (!(inlier_prior_count > 0.0)) error << "inlier_prior_count must be > 0; ";
+  if (!(min_inlier_ratio >= 0.0 && min_inlier_ratio < 1.0)) {
+    error << "min_inlier_ratio must be in [0, 1); ";
+  }
   if (blacklist_threshold <= 0) error << "blacklist_threshold must be > 0; ";
   if (max_reference_points < 0) error << "max_reference_points must be >= 0; ";
   if (regularization_radius < 1) error << "regularization_radius must be >= 1; ";

@@ -14,6 +14,7 @@ namespace pldvo {
 
 struct MappingOptions {
   enum class Init { kRandom, kConstant };
+  enum class OutlierModel { kValidityCounter, kInlierRatio };
 
   // ---- Pixel selection.
   // A keyframe pixel gets a depth hypothesis when |grad I| (central differences, gray levels per
@@ -95,6 +96,17 @@ struct MappingOptions {
   int validity_increment = 5;  // per fused observation
   int validity_decrement = 5;  // per outlier; the hypothesis is dropped when it reaches <= 0
   int validity_max = 100;
+  // How fusion treats outliers. kValidityCounter: the hard gate above and the validity counter
+  // (Engel 2013). kInlierRatio: the Gaussian x uniform mixture of Vogiatzis & Hernandez (IVC
+  // 2011), as in SVO/REMODE: each observation is an inlier N(D, V_obs) with probability pi or
+  // uniform on [min_idepth, max_idepth]; the posterior is approximated by N(D | mu, V) Beta(pi |
+  // a, b), with no hard gate (SemiDenseDepthMap::Fuse).
+  OutlierModel outlier_model = OutlierModel::kValidityCounter;
+  // kInlierRatio: the Beta prior of a new hypothesis, a = b = this (SVO: 10).
+  double inlier_prior_count = 10.0;
+  // kInlierRatio: a hypothesis whose expected inlier ratio a / (a + b) falls below this is
+  // dropped (SVO: 0.1).
+  double min_inlier_ratio = 0.1;
   int blacklist_threshold = 5;  // a pixel whose stereo failed this often is no longer searched
 
   // ---- Regularisation (Engel 2013 Sec. 2.3).
@@ -187,6 +199,15 @@ struct MappingOptions {
     v.Field("validity_increment", &validity_increment, "Validity gain per observation (5).");
     v.Field("validity_decrement", &validity_decrement, "Validity loss per outlier (5).");
     v.Field("validity_max", &validity_max, "Validity counter cap (100).");
+    v.Choice("outlier_model", &outlier_model,
+             {{"validity_counter", OutlierModel::kValidityCounter},
+              {"inlier_ratio", OutlierModel::kInlierRatio}},
+             "Outliers in fusion: hard gate and validity counter (Engel 2013), or the Gaussian x "
+             "uniform inlier-ratio filter (Vogiatzis & Hernandez 2011).");
+    v.Field("inlier_prior_count", &inlier_prior_count,
+            "inlier_ratio: Beta(a, b) prior of a new hypothesis, a = b = this (10).");
+    v.Field("min_inlier_ratio", &min_inlier_ratio,
+            "inlier_ratio: drop hypotheses whose expected inlier ratio falls below this (0.1).");
     v.Field("blacklist_threshold", &blacklist_threshold,
             "Stereo failures after which a pixel is no longer searched (5).");
     v.Field("regularize", &regularize, "Smooth the map among compatible neighbours.");

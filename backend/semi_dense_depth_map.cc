@@ -23,6 +23,8 @@ SemiDenseDepthMap::SemiDenseDepthMap(int width, int height) : width_(width), hei
   blacklist_.assign(n, 0);
   num_observations_.assign(n, 0);
   idepth_shared_sd_.assign(n, 0.f);
+  inlier_evidence_.assign(n, 0.f);
+  outlier_evidence_.assign(n, 0.f);
 }
 
 void SemiDenseDepthMap::SelectPixels(const ImagePyramid& keyframe, const cv::Mat& edge_id_map,
@@ -42,6 +44,8 @@ void SemiDenseDepthMap::SelectPixels(const ImagePyramid& keyframe, const cv::Mat
   std::fill(blacklist_.begin(), blacklist_.end(), 0);
   std::fill(num_observations_.begin(), num_observations_.end(), 0);
   std::fill(idepth_shared_sd_.begin(), idepth_shared_sd_.end(), 0.f);
+  std::fill(inlier_evidence_.begin(), inlier_evidence_.end(), 0.f);
+  std::fill(outlier_evidence_.begin(), outlier_evidence_.end(), 0.f);
   const float threshold_sq =
       static_cast<float>(options.gradient_threshold * options.gradient_threshold);
   const int b = options.border_px;
@@ -98,6 +102,8 @@ void SemiDenseDepthMap::Set(int i, double idepth, double idepth_var, int validit
   valid_[i] = 1;
   validity_[i] = static_cast<int16_t>(validity);
   num_observations_[i] = 0;
+  inlier_evidence_[i] = 0.f;
+  outlier_evidence_[i] = 0.f;
 }
 
 void SemiDenseDepthMap::SetCandidate(int i, bool candidate, int edge_id) {
@@ -105,39 +111,86 @@ void SemiDenseDepthMap::SetCandidate(int i, bool candidate, int edge_id) {
   edge_id_[i] = edge_id;
 }
 
+namespace {
+
+// The Gaussian fusion of Fuse (header): the posterior mean, variance and shared sd of a prior
+// (D, V, B) and an observation (D_obs, V_obs) whose error has the shared fraction rho.
+struct GaussianPosterior {
+  double idepth, idepth_var, shared_sd;
+};
+
+GaussianPosterior FuseGaussian(double prior, double prior_var, double prior_shared_sd,
+                               double idepth_obs, double idepth_obs_var, double correlation) {
+  if (correlation == 0.0 && prior_shared_sd == 0.0) {
+    // Independent errors: the product of Gaussians.
+    const double sum_var = prior_var + idepth_obs_var;
+    return {(idepth_obs_var * prior + prior_var * idepth_obs) / sum_var,
+            prior_var * idepth_obs_var / sum_var, 0.0};
+  }
+  // Correlated errors (header): A, B the prior's independent variance and shared sd, beta the
+  // observation's shared sd, obs_independent_var its independent variance.
+  const double b = std::min(prior_shared_sd, std::sqrt(prior_var));
+  const double a = prior_var - b * b;
+  const double beta = std::sqrt(correlation * idepth_obs_var);
+  const double obs_independent_var = (1.0 - correlation) * idepth_obs_var;
+  const double denominator = a + obs_independent_var + (b - beta) * (b - beta);
+  const double kappa =
+      denominator > 0.0 ? std::clamp((a + b * (b - beta)) / denominator, 0.0, 1.0) : 0.5;
+  const double shared_sd = (1.0 - kappa) * b + kappa * beta;
+  return {prior + kappa * (idepth_obs - prior),
+          (1.0 - kappa) * (1.0 - kappa) * a + kappa * kappa * obs_independent_var +
+              shared_sd * shared_sd,
+          shared_sd};
+}
+
+}  // namespace
+
 bool SemiDenseDepthMap::Fuse(int i, double idepth_obs, double idepth_obs_var, double correlation,
                              const MappingOptions& options) {
   const double prior = idepth_[i], prior_var = idepth_var_[i];
   const double diff = idepth_obs - prior;
+  const GaussianPosterior fused =
+      FuseGaussian(prior, prior_var, idepth_shared_sd_[i], idepth_obs, idepth_obs_var, correlation);
+  if (options.outlier_model == MappingOptions::OutlierModel::kInlierRatio) {
+    // Vogiatzis & Hernandez 2011, Sec. 3 (header).
+    constexpr double kInvSqrt2Pi = 0.3989422804014327;
+    const double a = options.inlier_prior_count + inlier_evidence_[i];
+    const double b = options.inlier_prior_count + outlier_evidence_[i];
+    const double sum_var = prior_var + idepth_obs_var;
+    const double c1_unnormalised =
+        a * kInvSqrt2Pi / std::sqrt(sum_var) * std::exp(-0.5 * diff * diff / sum_var);
+    const double c2_unnormalised = b / (options.max_idepth - options.min_idepth);
+    // A hypothesis without observations (random initialisation, hole filling) is as wide as the
+    // outlier density; its first observation is taken as an inlier, as in an unmapped pixel.
+    const double c1 =
+        num_observations_[i] == 0 ? 1.0 : c1_unnormalised / (c1_unnormalised + c2_unnormalised);
+    const double c2 = 1.0 - c1;
+    const double f = c1 * (a + 1.0) / (a + b + 1.0) + c2 * a / (a + b + 1.0);
+    const double e = c1 * (a + 1.0) * (a + 2.0) / ((a + b + 1.0) * (a + b + 2.0)) +
+                     c2 * a * (a + 1.0) / ((a + b + 1.0) * (a + b + 2.0));
+    const double a_new = (e - f) / (f - e / f);
+    const double b_new = a_new * (1.0 - f) / f;
+    const double step = fused.idepth - prior;
+    idepth_[i] = static_cast<float>(prior + c1 * step);
+    idepth_var_[i] =
+        static_cast<float>(c1 * fused.idepth_var + c2 * prior_var + c1 * c2 * step * step);
+    idepth_shared_sd_[i] = static_cast<float>(c1 * fused.shared_sd + c2 * idepth_shared_sd_[i]);
+    inlier_evidence_[i] = static_cast<float>(a_new - options.inlier_prior_count);
+    outlier_evidence_[i] = static_cast<float>(b_new - options.inlier_prior_count);
+    if (a_new / (a_new + b_new) < options.min_inlier_ratio) valid_[i] = 0;
+    if (c1 <= c2) return false;
+    CountObservation(i);
+    return true;
+  }
   const double gate = options.outlier_gate_sigmas;
   if (diff * diff > gate * gate * (prior_var + idepth_obs_var)) {
     validity_[i] = static_cast<int16_t>(validity_[i] - options.validity_decrement);
     if (validity_[i] <= 0) valid_[i] = 0;
     return false;
   }
-  const double prior_shared_sd = idepth_shared_sd_[i];
-  if (correlation == 0.0 && prior_shared_sd == 0.0) {
-    // Independent errors: the product of Gaussians.
-    const double sum_var = prior_var + idepth_obs_var;
-    idepth_[i] = static_cast<float>((idepth_obs_var * prior + prior_var * idepth_obs) / sum_var);
-    idepth_var_[i] = static_cast<float>(prior_var * idepth_obs_var / sum_var);
-  } else {
-    // Correlated errors (header): A, B the prior's independent variance and shared sd, beta the
-    // observation's shared sd, obs_independent_var its independent variance.
-    const double b = std::min(prior_shared_sd, std::sqrt(prior_var));
-    const double a = prior_var - b * b;
-    const double beta = std::sqrt(correlation * idepth_obs_var);
-    const double obs_independent_var = (1.0 - correlation) * idepth_obs_var;
-    const double denominator = a + obs_independent_var + (b - beta) * (b - beta);
-    const double kappa =
-        denominator > 0.0 ? std::clamp((a + b * (b - beta)) / denominator, 0.0, 1.0) : 0.5;
-    const double shared_sd = (1.0 - kappa) * b + kappa * beta;
-    idepth_[i] = static_cast<float>(prior + kappa * diff);
-    idepth_var_[i] =
-        static_cast<float>((1.0 - kappa) * (1.0 - kappa) * a + kappa * kappa * obs_independent_var +
-                           shared_sd * shared_sd);
-    idepth_shared_sd_[i] = static_cast<float>(shared_sd);
-  }
+  idepth_[i] = static_cast<float>(fused.idepth);
+  idepth_var_[i] = static_cast<float>(fused.idepth_var);
+  idepth_shared_sd_[i] = static_cast<float>(fused.shared_sd);
   validity_[i] = static_cast<int16_t>(
       std::min(options.validity_max, validity_[i] + options.validity_increment));
   CountObservation(i);

@@ -59,11 +59,21 @@ class SemiDenseDepthMap {
   // B of Fuse: the standard deviation of the hypothesis' error component that is shared with
   // the pixel's future stereo observations, 1/m; B^2 <= V.
   float idepth_shared_sd(int i) const { return idepth_shared_sd_[i]; }
+  // The Beta(pi | a, b) posterior of the inlier ratio (outlier_model kInlierRatio) is kept as the
+  // evidence beyond the prior: a = options.inlier_prior_count + inlier_evidence, b likewise with
+  // outlier_evidence. Both are 0 for a new hypothesis.
+  float inlier_evidence(int i) const { return inlier_evidence_[i]; }
+  float outlier_evidence(int i) const { return outlier_evidence_[i]; }
+  // Propagation carries the evidence to the new keyframe's hypothesis.
+  void SetEvidence(int i, double inlier_evidence, double outlier_evidence) {
+    inlier_evidence_[i] = static_cast<float>(inlier_evidence);
+    outlier_evidence_[i] = static_cast<float>(outlier_evidence);
+  }
 
-  // Sets a new hypothesis: marks it valid and resets its observation count. idepth_shared_sd is
-  // B of Fuse: 0 for a hypothesis whose error is independent of future stereo observations
-  // (initialisation, propagation, hole filling), sqrt(rho V) for one created from a stereo
-  // observation.
+  // Sets a new hypothesis: marks it valid and resets its observation count and evidence.
+  // idepth_shared_sd is B of Fuse: 0 for a hypothesis whose error is independent of future stereo
+  // observations (initialisation, propagation, hole filling), sqrt(rho V) for one created from a
+  // stereo observation.
   void Set(int i, double idepth, double idepth_var, int validity, double idepth_shared_sd = 0.0);
   // Changes the mean only (regularisation); the pixel must be valid.
   void SetIdepth(int i, double idepth) { idepth_[i] = static_cast<float>(idepth); }
@@ -95,9 +105,21 @@ class SemiDenseDepthMap {
   //   D' = (V_obs D + V D_obs) / (V + V_obs),   V' = V V_obs / (V + V_obs);
   // with rho > 0, n observations of equal s into a flat prior give their mean with
   // V = rho s^2 + (1 - rho) s^2 / n (a floor).
-  // When |D_obs - D| > gate_sigmas sqrt(V + V_obs) the observation is an outlier: the validity
-  // counter drops by options.validity_decrement and the hypothesis is invalidated at <= 0.
-  // Otherwise the validity rises by options.validity_increment (capped). Returns true when fused.
+  // Outliers, options.outlier_model:
+  // - kValidityCounter: when |D_obs - D| > gate_sigmas sqrt(V + V_obs) the observation is an
+  //   outlier: the validity counter drops by options.validity_decrement and the hypothesis is
+  //   invalidated at <= 0. Otherwise the validity rises by options.validity_increment (capped).
+  // - kInlierRatio (Vogiatzis & Hernandez 2011, Sec. 3): D_obs ~ pi N(D, V + V_obs) + (1 - pi)
+  //   U[min_idepth, max_idepth], posterior N(D | mu, V) Beta(pi | a, b) by moment matching.
+  //   With C1, C2 the normalised a N(D_obs | D, V + V_obs), b U (the inlier and outlier
+  //   responsibilities) and (m, s^2) the Gaussian fusion above:
+  //     mu' = C1 m + C2 D,   V' = C1 s^2 + C2 V + C1 C2 (m - D)^2,
+  //     f = C1 (a+1)/(a+b+1) + C2 a/(a+b+1),   e = C1 (a+1)(a+2)/((a+b+1)(a+b+2))
+  //       + C2 a(a+1)/((a+b+1)(a+b+2)),   a' = (e - f)/(f - e/f),   b' = a' (1 - f)/f;
+  //   the hypothesis is invalidated when a'/(a'+b') < options.min_inlier_ratio. The first
+  //   observation of a hypothesis without observations (random initialisation, hole filling) is
+  //   taken as an inlier (C1 = 1): such a prior is as wide as the outlier density.
+  // Returns true when fused (kInlierRatio: when C1 > C2).
   bool Fuse(int i, double idepth_obs, double idepth_obs_var, double correlation,
             const MappingOptions& options);
   // A stereo observation: correlation = options.stereo_error_correlation.
@@ -120,6 +142,8 @@ class SemiDenseDepthMap {
   std::vector<int16_t> blacklist_;
   std::vector<uint16_t> num_observations_;
   std::vector<float> idepth_shared_sd_;
+  std::vector<float> inlier_evidence_;
+  std::vector<float> outlier_evidence_;
 };
 
 }  // namespace pldvo
