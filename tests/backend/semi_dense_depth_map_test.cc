@@ -273,10 +273,10 @@ TEST(SemiDenseDepthMapTest, InlierRatioFilterIsConsistentUnderUniformOutliers) {
   // every pixel and its NEES is chi^2(1): measured mean 1.021 (standard error 0.01), 0.14% above
   // 10.83 (without the C1 C2 (m - mu)^2 term of V', a mutation, 1.206 and 0.37%); its expected
   // inlier ratio 0.624 (the posterior mean of pi from Beta(10, 10) and ~21 of 30 inliers is
-  // ~0.63). The validity counter on the same samples drops 10% of the pixels (an outlier passes
-  // its gate while the prior is wide, then the inliers fail it) and is overconfident on the rest
-  // (the 2-sigma gate cuts the inliers' tails): mean NEES 1.380, 0.62% gross. Other rates:
-  // docs/mapping.md.
+  // ~0.63). The validity counter on the same samples drops 10% of the pixels (the random prior
+  // is more than 2 sigma off, or an outlier passes the gate while the prior is wide; then the
+  // inliers fail the gate) and is overconfident on the rest (the gate cuts the inliers' tails):
+  // mean NEES 1.380, 0.62% gross. Other rates: docs/mapping.md.
   using Model = MappingOptions::OutlierModel;
   const OutlierFilterStats ratio = SimulateOutlierFilter(Model::kInlierRatio, 0.7, true);
   EXPECT_EQ(ratio.kept_fraction, 1.0);
