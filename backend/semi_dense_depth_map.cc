@@ -149,8 +149,6 @@ bool SemiDenseDepthMap::Fuse(int i, double idepth_obs, double idepth_obs_var, do
                              const MappingOptions& options) {
   const double prior = idepth_[i], prior_var = idepth_var_[i];
   const double diff = idepth_obs - prior;
-  const GaussianPosterior fused =
-      FuseGaussian(prior, prior_var, idepth_shared_sd_[i], idepth_obs, idepth_obs_var, correlation);
   if (options.outlier_model == MappingOptions::OutlierModel::kInlierRatio) {
     // Vogiatzis & Hernandez 2011, Sec. 3 (header).
     constexpr double kInvSqrt2Pi = 0.3989422804014327;
@@ -170,6 +168,8 @@ bool SemiDenseDepthMap::Fuse(int i, double idepth_obs, double idepth_obs_var, do
                      c2 * a * (a + 1.0) / ((a + b + 1.0) * (a + b + 2.0));
     const double a_new = (e - f) / (f - e / f);
     const double b_new = a_new * (1.0 - f) / f;
+    const GaussianPosterior fused = FuseGaussian(prior, prior_var, idepth_shared_sd_[i], idepth_obs,
+                                                 idepth_obs_var, correlation);
     const double step = fused.idepth - prior;
     idepth_[i] = static_cast<float>(prior + c1 * step);
     idepth_var_[i] =
@@ -188,6 +188,8 @@ bool SemiDenseDepthMap::Fuse(int i, double idepth_obs, double idepth_obs_var, do
     if (validity_[i] <= 0) valid_[i] = 0;
     return false;
   }
+  const GaussianPosterior fused =
+      FuseGaussian(prior, prior_var, idepth_shared_sd_[i], idepth_obs, idepth_obs_var, correlation);
   idepth_[i] = static_cast<float>(fused.idepth);
   idepth_var_[i] = static_cast<float>(fused.idepth_var);
   idepth_shared_sd_[i] = static_cast<float>(fused.shared_sd);
