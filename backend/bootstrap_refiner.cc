@@ -4,37 +4,31 @@
 #include <stdexcept>
 #include <string>
 
+#include "backend/depth_map_io.h"
 #include "backend/odometry.h"
 #include "backend/odometry_observer.h"
-#include "core/evaluation.h"
 #include "core/wall_clock.h"
 
 namespace pldvo {
 namespace {
 
-// Keeps the first keyframe's final map as z-depth (observed hypotheses only, as the PLY export).
+// Keeps the first keyframe's final map as z-depth (NormalizedObservedDepth).
 class FirstKeyframeCapture : public OdometryObserver {
  public:
   bool WantsKeyframeMaps() const override { return true; }
   void OnKeyframeFinished(const KeyframeInfo& keyframe, const SemiDenseDepthMap& map) override {
     if (captured_ || keyframe.keyframe_id != 0) return;
     captured_ = true;
-    depth_ = cv::Mat::zeros(map.height(), map.width(), CV_32F);
-    for (int i = 0; i < map.num_pixels(); ++i) {
-      if (!map.observed(i)) continue;
-      depth_.at<float>(i / map.width(), i % map.width()) = 1.f / map.idepth(i);
-      idepths_.push_back(map.idepth(i));
-    }
+    depth_ = NormalizedObservedDepth(map, &points_);
   }
   bool captured() const { return captured_; }
-  // The depth with the median inverse depth scaled to 1 (the scale is arbitrary).
-  cv::Mat NormalizedDepth() const { return depth_ * Median(idepths_); }
-  int points() const { return static_cast<int>(idepths_.size()); }
+  const cv::Mat& depth() const { return depth_; }
+  int points() const { return points_; }
 
  private:
   bool captured_ = false;
   cv::Mat depth_;
-  std::vector<double> idepths_;
+  int points_ = 0;
 };
 
 }  // namespace
@@ -71,7 +65,7 @@ BootstrapRefinement RefineBootstrap(const Dataset& dataset, const OdometryConfig
       throw std::runtime_error("bootstrap refinement pass " + std::to_string(pass) +
                                ": the first keyframe's map has no observed hypothesis");
     }
-    refinement.depth = capture.NormalizedDepth();
+    refinement.depth = capture.depth();
     refinement.frames.push_back(i);
     refinement.points.push_back(capture.points());
   }

@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "core/evaluation.h"
+
 namespace pldvo {
 
 cv::Mat ColorizeInverseDepth(const SemiDenseDepthMap& map, double idepth_min, double idepth_max) {
@@ -85,6 +87,23 @@ int WritePointCloudPly(const SemiDenseDepthMap& map, const cv::Mat& image,
   }
   if (!out) throw std::runtime_error("WritePointCloudPly: write failed for " + path);
   return count;
+}
+
+cv::Mat NormalizedObservedDepth(const SemiDenseDepthMap& map, int* count, double* median_idepth) {
+  std::vector<double> idepths;
+  for (int i = 0; i < map.num_pixels(); ++i) {
+    if (map.observed(i) && map.idepth(i) > 0.0) idepths.push_back(map.idepth(i));
+  }
+  *count = static_cast<int>(idepths.size());
+  if (idepths.empty()) return cv::Mat();
+  const double median = Median(idepths);
+  if (median_idepth != nullptr) *median_idepth = median;
+  cv::Mat depth = cv::Mat::zeros(map.height(), map.width(), CV_32F);
+  for (int i = 0; i < map.num_pixels(); ++i) {
+    if (!map.observed(i) || map.idepth(i) <= 0.0) continue;
+    depth.at<float>(i / map.width(), i % map.width()) = static_cast<float>(median / map.idepth(i));
+  }
+  return depth;
 }
 
 }  // namespace pldvo

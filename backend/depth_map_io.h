@@ -31,6 +31,14 @@ int WritePointCloudPly(const SemiDenseDepthMap& map, const cv::Mat& image,
                        const PinholeCamera& camera, const SE3& world_from_cam,
                        const std::string& path);
 
+// The z-depth image (CV_32F, the map's size) of the hypotheses with at least one stereo
+// observation and idepth > 0, scaled so that their median inverse depth is 1 (the scale of a
+// monocular map is arbitrary), 0 elsewhere: a start map for odometry.init_depth_idepth_var-style
+// initialisation. Sets *count to the number of such hypotheses and, if given, *median_idepth to
+// their median inverse depth; empty image when there are none.
+cv::Mat NormalizedObservedDepth(const SemiDenseDepthMap& map, int* count,
+                                double* median_idepth = nullptr);
+
 }  // namespace pldvo
 
 #endif  // PLDVO_BACKEND_DEPTH_MAP_IO_H_

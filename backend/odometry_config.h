@@ -122,10 +122,20 @@ struct OdometryOptions {
   // Bootstrap refinement (backend/bootstrap_refiner.h), monocular runs: before the run, this many
   // passes minus one over the first keyframe's frames, each starting from the map the previous
   // one ended with (the first from the random map); the run then starts from the last map with
-  // inverse-depth variance bootstrap_idepth_var, relative to a median inverse depth of 1.
+  // inverse-depth variance bootstrap_idepth_var, relative to a median inverse depth of 1 (also
+  // the variance of the two-view bootstrap's map, below).
   // 1 = off (default).
   int bootstrap_passes = 1;
   double bootstrap_idepth_var = 0.05;
+  // Two-view bootstrap (backend/two_view_bootstrap.h), monocular runs: frame 0's map from the
+  // first frame k <= two_view_max_frames where two_view_min_inliers tracked corners triangulate
+  // (essential matrix) with a median parallax of two_view_min_parallax_deg, the poses of frames
+  // 1..k bundle-adjusted, and stereo with them; the run starts from it with bootstrap_idepth_var.
+  // Off by default (the random map); when it fails the run starts from the random map.
+  bool two_view_bootstrap = false;
+  double two_view_min_parallax_deg = 2.0;
+  int two_view_min_inliers = 50;
+  int two_view_max_frames = 60;
   // Solver comparison (docs/tracking.md): every tracked frame's final tracking problem (the same
   // reference, lines and initial pose) is solved a second time with this solver; its poses, RPE
   // and time are reported beside the run's (summary.json `compare_solver`,
@@ -174,8 +184,18 @@ struct OdometryOptions {
             "Monocular: passes over the first keyframe's frames, each re-estimating its map from "
             "the previous pass's map; the run starts from the last (1 = off, default).");
     v.Field("bootstrap_idepth_var", &bootstrap_idepth_var,
-            "Inverse-depth variance of a refined start map, median inverse depth scaled to 1 "
+            "Inverse-depth variance of a refined or two-view start map, median inverse depth 1 "
             "(default 0.05).");
+    v.Field("two_view_bootstrap", &two_view_bootstrap,
+            "Monocular: frame 0's map from the two-view geometry of tracked corners and stereo "
+            "with the frames up to the second view; the run starts from it (default false).");
+    v.Field("two_view_min_parallax_deg", &two_view_min_parallax_deg,
+            "Two-view bootstrap: median parallax of the triangulated corners that makes a frame "
+            "the second view, deg (default 2).");
+    v.Field("two_view_min_inliers", &two_view_min_inliers,
+            "Two-view bootstrap: triangulated essential-matrix inliers needed (default 50).");
+    v.Field("two_view_max_frames", &two_view_max_frames,
+            "Two-view bootstrap: frames searched for the second view (default 60).");
     v.Choice("compare_solver", &compare_solver,
              ChoiceNames<CompareSolver>{{"none", CompareSolver::kNone},
                                         {"ceres", CompareSolver::kCeres},

@@ -43,6 +43,7 @@
 #include "backend/frame_preparer.h"
 #include "backend/odometry.h"
 #include "backend/odometry_config.h"
+#include "backend/two_view_bootstrap.h"
 #include "core/config_io.h"
 #include "core/dataset.h"
 #include "core/evaluation.h"
@@ -224,6 +225,24 @@ int RunOdometryCommand(const CommandContext& context) {
                 << "); the run starts from the random map\n";
     }
   }
+  // odometry.two_view_bootstrap: the run starts from frame 0's map of the two-view bootstrap
+  // (or from the random map, said so, when it fails).
+  TwoViewBootstrap two_view;
+  run_config.odometry.two_view_bootstrap = false;  // the run starts from its map, as from depth
+  if (config.odometry.two_view_bootstrap && num_frames > 0) {
+    try {
+      two_view = BootstrapFromTwoViews(*dataset, config, num_frames);
+      bootstrap.depth = two_view.depth;
+      run_config.odometry.init_depth_idepth_var = config.odometry.bootstrap_idepth_var;
+      std::cerr << "pldvo run: two-view bootstrap: second view frame " << two_view.second_view
+                << ", " << two_view.inliers << " of " << two_view.tracks
+                << " corners triangulated, median parallax " << two_view.parallax_deg << " deg, "
+                << two_view.points << " hypotheses, " << static_cast<int>(two_view.ms) << " ms\n";
+    } catch (const std::exception& e) {
+      two_view = TwoViewBootstrap();
+      std::cerr << "pldvo run: " << e.what() << "; the run starts from the random map\n";
+    }
+  }
   std::unique_ptr<Odometry> odometry;
   try {
     odometry = std::make_unique<Odometry>(dataset->camera(), run_config, &outputs);
@@ -355,6 +374,15 @@ int RunOdometryCommand(const CommandContext& context) {
   if (!bootstrap.frames.empty()) {
     summary["bootstrap"] = {
         {"frames", bootstrap.frames}, {"points", bootstrap.points}, {"ms", bootstrap.ms}};
+  }
+  // odometry.two_view_bootstrap: the second view, its triangulated corners and median parallax,
+  // frame 0's hypotheses, wall time (before the run).
+  summary["two_view_bootstrap"] = nullptr;
+  if (two_view.second_view >= 0) {
+    summary["two_view_bootstrap"] = {
+        {"second_view", two_view.second_view}, {"tracks", two_view.tracks},
+        {"inliers", two_view.inliers},         {"parallax_deg", two_view.parallax_deg},
+        {"points", two_view.points},           {"ms", two_view.ms}};
   }
   summary["fps"] = run_seconds > 0.0 ? num_frames / run_seconds : 0.0;
   // Edge bundle adjustment (backend.edge_ba): windows solved, applied, CPU ms per window.

@@ -638,5 +638,36 @@ TEST(DepthMapIoTest, WritesPngAndPly) {
   EXPECT_THROW(WriteInverseDepthPng(map, "/nonexistent_dir/x.png"), std::runtime_error);
 }
 
+TEST(DepthMapIoTest, NormalizedObservedDepthHasMedianInverseDepthOne) {
+  const PinholeCamera camera = TestCamera();
+  SemiDenseDepthMap map(camera.width, camera.height);
+  int count = -1;
+  EXPECT_TRUE(NormalizedObservedDepth(map, &count).empty());
+  EXPECT_EQ(count, 0);
+  // Observed inverse depths 0.5, 1, 2 (median 1 -> scaled by 1), then 1, 2, 4 (median 2); an
+  // unobserved hypothesis and an observed one at idepth 0 are left out.
+  const double idepths[] = {0.5, 1.0, 2.0};
+  for (double factor : {1.0, 2.0}) {
+    for (int x = 0; x < 3; ++x) {
+      map.Set(map.Index(x, 0), factor * idepths[x], 0.01, 20);
+      map.CountObservation(map.Index(x, 0));
+    }
+    map.Set(map.Index(5, 0), 3.0, 0.01, 20);
+    map.Set(map.Index(6, 0), 0.0, 0.01, 20);
+    map.CountObservation(map.Index(6, 0));
+    double median = 0.0;
+    const cv::Mat depth = NormalizedObservedDepth(map, &count, &median);
+    EXPECT_EQ(count, 3);
+    EXPECT_DOUBLE_EQ(median, factor);
+    ASSERT_EQ(depth.type(), CV_32F);
+    EXPECT_FLOAT_EQ(depth.at<float>(0, 0), 2.f);
+    EXPECT_FLOAT_EQ(depth.at<float>(0, 1), 1.f);
+    EXPECT_FLOAT_EQ(depth.at<float>(0, 2), 0.5f);
+    EXPECT_EQ(depth.at<float>(0, 5), 0.f);
+    EXPECT_EQ(depth.at<float>(0, 6), 0.f);
+    EXPECT_EQ(cv::countNonZero(depth), 3);
+  }
+}
+
 }  // namespace
 }  // namespace pldvo

@@ -319,6 +319,53 @@ TEST(RunCommandTest, BootstrapRefinementRerunsTheFirstKeyframeFrames) {
   }
 }
 
+// odometry.two_view_bootstrap: the run reports the second view and tracks every frame from frame
+// 0's bootstrapped map (1 deg of parallax: this sequence moves forward and does not reach the
+// default 2 deg in 36 frames); when the bootstrap fails (two frames, no parallax) the run starts
+// from the random map and says why; combinations with the other starts are config errors.
+TEST(RunCommandTest, TwoViewBootstrapStartsTheRunOrFallsBack) {
+  const std::string kFlags = kDeterministic + std::string(" --max_frames 36");
+  const fs::path run = TestRoot() / "run_two_view";
+  ASSERT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " + run.string() + kFlags +
+                      " --set odometry.two_view_bootstrap=true"
+                      " --set odometry.two_view_min_parallax_deg=1",
+                  TestRoot() / "run_two_view.log"),
+            0)
+      << Slurp(TestRoot() / "run_two_view.log");
+  const nlohmann::json summary = nlohmann::json::parse(Slurp(run / "summary.json"));
+  const nlohmann::json& two_view = summary["two_view_bootstrap"];
+  ASSERT_TRUE(two_view.is_object()) << Slurp(TestRoot() / "run_two_view.log");
+  std::printf("two-view bootstrap: %s\n", two_view.dump().c_str());
+  EXPECT_GT(two_view["second_view"].get<int>(), 0);
+  EXPECT_LT(two_view["second_view"].get<int>(), 36);
+  EXPECT_GE(two_view["parallax_deg"].get<double>(), 1.0);
+  EXPECT_GT(two_view["points"].get<int>(), 1000);
+  EXPECT_EQ(summary["tracked"].get<int>(), 36);
+
+  const fs::path two = TestRoot() / "run_two_view_two_frames";
+  ASSERT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " + two.string() +
+                      kDeterministic + " --max_frames 2 --set odometry.two_view_bootstrap=true",
+                  TestRoot() / "run_two_view_two_frames.log"),
+            0);
+  const std::string log = Slurp(TestRoot() / "run_two_view_two_frames.log");
+  EXPECT_NE(log.find("parallax"), std::string::npos) << log;
+  EXPECT_NE(log.find("starts from the random map"), std::string::npos) << log;
+  EXPECT_TRUE(nlohmann::json::parse(Slurp(two / "summary.json"))["two_view_bootstrap"].is_null());
+
+  for (const std::string& bad : {std::string(" --set odometry.bootstrap_passes=2"),
+                                 std::string(" --set odometry.init_depth_idepth_var=0.0001"),
+                                 std::string(" --set odometry.two_view_min_parallax_deg=0")}) {
+    const fs::path bad_log = TestRoot() / "run_two_view_bad.log";
+    EXPECT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " +
+                        (TestRoot() / "run_two_view_bad").string() +
+                        " --set odometry.two_view_bootstrap=true" + bad,
+                    bad_log),
+              2)
+        << bad;
+    EXPECT_NE(Slurp(bad_log).find("two_view"), std::string::npos) << Slurp(bad_log);
+  }
+}
+
 TEST(RunCommandTest, UnknownConfigKeyIsAnError) {
   // The config is checked before the dataset is opened: no dataset needed.
   const fs::path log = TestRoot() / "run_bad_key.log";

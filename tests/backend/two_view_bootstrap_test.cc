@@ -1,0 +1,157 @@
+// The two-view bootstrap (backend/two_view_bootstrap.h) on a small rendered textured sequence
+// (320x240, 36 frames) against its ground truth: the second view's pose and frame 0's map; and
+// its errors when the camera does not move or the image has no corners.
+#include "backend/two_view_bootstrap.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include "backend/odometry_config.h"
+#include "core/dataset.h"
+#include "core/evaluation.h"
+#include "core/synthetic/synthetic_sequence.h"
+#include "tests/render_cache.h"
+#include "tests/small_lowtex_options.h"
+
+namespace pldvo {
+namespace {
+
+constexpr int kFrames = 36;
+
+// Rendered frames held in memory as a Dataset (frame_of[i] is the rendered frame shown as i).
+class RenderedDataset : public Dataset {
+ public:
+  RenderedDataset(const synthetic::SyntheticSequence& sequence, std::vector<cv::Mat> images,
+                  cv::Mat first_depth, std::vector<int> frame_of)
+      : sequence_(sequence),
+        images_(std::move(images)),
+        first_depth_(std::move(first_depth)),
+        frame_of_(std::move(frame_of)) {}
+  std::string format() const override { return "rendered"; }
+  int size() const override { return static_cast<int>(frame_of_.size()); }
+  double timestamp(int i) const override { return i / 30.0; }
+  Frame Load(int i) const override {
+    Frame frame;
+    frame.index = i;
+    frame.timestamp = timestamp(i);
+    frame.image = images_.at(frame_of_.at(i));
+    return frame;
+  }
+  cv::Mat LoadDepth(int i) const override { return i == 0 ? first_depth_ : cv::Mat(); }
+  const PinholeCamera& camera() const override { return sequence_.camera; }
+  const Trajectory* ground_truth() const override { return &sequence_.ground_truth; }
+
+ private:
+  const synthetic::SyntheticSequence& sequence_;
+  std::vector<cv::Mat> images_;
+  cv::Mat first_depth_;
+  std::vector<int> frame_of_;
+};
+
+struct TexturedSequence {
+  synthetic::SyntheticSequence sequence;
+  std::vector<cv::Mat> images;  // CV_32F, the first `frames` rendered
+  cv::Mat first_depth;
+};
+
+// The textured preset, seed 2, at the size of the small test sequence; renders `frames` frames.
+TexturedSequence Textured(int frames) {
+  synthetic::SynthOptions options = test::SmallLowtexOptions(kFrames);
+  options.preset = "textured";
+  options.seed = 2;
+  TexturedSequence result;
+  result.sequence = synthetic::MakeSequence(options);
+  for (int i = 0; i < frames; ++i) {
+    const synthetic::RenderedFrame frame = test::RenderFrameForTest(result.sequence, i);
+    cv::Mat image;
+    frame.image.convertTo(image, CV_32F);
+    result.images.push_back(image);
+    if (i == 0) result.first_depth = frame.depth;
+  }
+  return result;
+}
+
+double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+TEST(TwoViewBootstrapTest, RecoversTheSecondViewAndFrameZerosMap) {
+  const TexturedSequence textured = Textured(kFrames);
+  std::vector<int> frames;
+  for (int i = 0; i < kFrames; ++i) frames.push_back(i);
+  const RenderedDataset dataset(textured.sequence, textured.images, textured.first_depth, frames);
+  OdometryConfig config;
+  const TwoViewBootstrap result = BootstrapFromTwoViews(dataset, config, kFrames);
+  ASSERT_GT(result.second_view, 0);
+  EXPECT_GE(result.inliers, config.odometry.two_view_min_inliers);
+  EXPECT_GE(result.parallax_deg, config.odometry.two_view_min_parallax_deg);
+
+  // The second view against the ground truth: rotation and translation direction.
+  const Trajectory& gt = *dataset.ground_truth();
+  const SE3 true_second_from_first =
+      gt[result.second_view].world_from_cam.Inverse() * gt[0].world_from_cam;
+  const double rotation_error_deg = Eigen::AngleAxisd(true_second_from_first.rotation().inverse() *
+                                                      result.second_from_first.rotation())
+                                        .angle() *
+                                    180.0 / M_PI;
+  const double direction_error_deg =
+      AngleDeg(result.second_from_first.translation(), true_second_from_first.translation());
+
+  // Frame 0's map after a median scale alignment; the pose's scale is the map's.
+  const cv::Mat& gt_depth = textured.first_depth;
+  std::vector<double> ratios;
+  for (int y = 0; y < gt_depth.rows; ++y) {
+    for (int x = 0; x < gt_depth.cols; ++x) {
+      const float z = result.depth.at<float>(y, x);
+      if (z > 0.f && gt_depth.at<float>(y, x) > 0.f) ratios.push_back(gt_depth.at<float>(y, x) / z);
+    }
+  }
+  ASSERT_GT(ratios.size(), 1000u);
+  const double scale = Median(ratios);
+  std::vector<double> errors;
+  for (double ratio : ratios) errors.push_back(std::abs(ratio / scale - 1.0));
+  const double map_error = Median(errors);
+  const double pose_scale =
+      true_second_from_first.translation().norm() / result.second_from_first.translation().norm();
+  std::printf(
+      "second view %d, %d of %d corners, parallax %.2f deg, rotation error %.3f deg, direction "
+      "error %.2f deg, map: %d points, median rel. error %.4f, pose scale / map scale %.3f\n",
+      result.second_view, result.inliers, result.tracks, result.parallax_deg, rotation_error_deg,
+      direction_error_deg, result.points, map_error, pose_scale / scale);
+  EXPECT_LT(rotation_error_deg, 0.25);
+  EXPECT_LT(direction_error_deg, 5.0);
+  EXPECT_LT(map_error, 0.03);
+  EXPECT_NEAR(pose_scale / scale, 1.0, 0.03);
+}
+
+TEST(TwoViewBootstrapTest, StaticCameraHasNoParallax) {
+  const TexturedSequence textured = Textured(1);
+  const RenderedDataset dataset(textured.sequence, textured.images, textured.first_depth,
+                                std::vector<int>(kFrames, 0));
+  try {
+    BootstrapFromTwoViews(dataset, OdometryConfig(), kFrames);
+    FAIL() << "a static camera must not bootstrap";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("parallax"), std::string::npos) << e.what();
+  }
+}
+
+TEST(TwoViewBootstrapTest, BlankFrameHasNoCorners) {
+  const TexturedSequence textured = Textured(1);
+  const RenderedDataset blank(textured.sequence,
+                              {cv::Mat(textured.images[0].size(), CV_32F, cv::Scalar(128))},
+                              textured.first_depth, std::vector<int>(kFrames, 0));
+  try {
+    BootstrapFromTwoViews(blank, OdometryConfig(), kFrames);
+    FAIL() << "a blank frame must not bootstrap";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("corners"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace pldvo
