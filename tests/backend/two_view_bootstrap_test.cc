@@ -26,11 +26,8 @@ constexpr int kFrames = 36;
 class RenderedDataset : public Dataset {
  public:
   RenderedDataset(const synthetic::SyntheticSequence& sequence, std::vector<cv::Mat> images,
-                  cv::Mat first_depth, std::vector<int> frame_of)
-      : sequence_(sequence),
-        images_(std::move(images)),
-        first_depth_(std::move(first_depth)),
-        frame_of_(std::move(frame_of)) {}
+                  std::vector<int> frame_of)
+      : sequence_(sequence), images_(std::move(images)), frame_of_(std::move(frame_of)) {}
   std::string format() const override { return "rendered"; }
   int size() const override { return static_cast<int>(frame_of_.size()); }
   double timestamp(int i) const override { return i / 30.0; }
@@ -41,14 +38,12 @@ class RenderedDataset : public Dataset {
     frame.image = images_.at(frame_of_.at(i));
     return frame;
   }
-  cv::Mat LoadDepth(int i) const override { return i == 0 ? first_depth_ : cv::Mat(); }
   const PinholeCamera& camera() const override { return sequence_.camera; }
   const Trajectory* ground_truth() const override { return &sequence_.ground_truth; }
 
  private:
   const synthetic::SyntheticSequence& sequence_;
   std::vector<cv::Mat> images_;
-  cv::Mat first_depth_;
   std::vector<int> frame_of_;
 };
 
@@ -83,7 +78,7 @@ TEST(TwoViewBootstrapTest, RecoversTheSecondViewAndFrameZerosMap) {
   const TexturedSequence textured = Textured(kFrames);
   std::vector<int> frames;
   for (int i = 0; i < kFrames; ++i) frames.push_back(i);
-  const RenderedDataset dataset(textured.sequence, textured.images, textured.first_depth, frames);
+  const RenderedDataset dataset(textured.sequence, textured.images, frames);
   OdometryConfig config;
   const TwoViewBootstrap result = BootstrapFromTwoViews(dataset, config, kFrames);
   ASSERT_GT(result.second_view, 0);
@@ -130,8 +125,7 @@ TEST(TwoViewBootstrapTest, RecoversTheSecondViewAndFrameZerosMap) {
 
 TEST(TwoViewBootstrapTest, StaticCameraHasNoParallax) {
   const TexturedSequence textured = Textured(1);
-  const RenderedDataset dataset(textured.sequence, textured.images, textured.first_depth,
-                                std::vector<int>(kFrames, 0));
+  const RenderedDataset dataset(textured.sequence, textured.images, std::vector<int>(kFrames, 0));
   try {
     BootstrapFromTwoViews(dataset, OdometryConfig(), kFrames);
     FAIL() << "a static camera must not bootstrap";
@@ -144,7 +138,7 @@ TEST(TwoViewBootstrapTest, BlankFrameHasNoCorners) {
   const TexturedSequence textured = Textured(1);
   const RenderedDataset blank(textured.sequence,
                               {cv::Mat(textured.images[0].size(), CV_32F, cv::Scalar(128))},
-                              textured.first_depth, std::vector<int>(kFrames, 0));
+                              std::vector<int>(kFrames, 0));
   try {
     BootstrapFromTwoViews(blank, OdometryConfig(), kFrames);
     FAIL() << "a blank frame must not bootstrap";
