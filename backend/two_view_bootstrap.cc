@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 #include <stdexcept>
@@ -75,10 +76,10 @@ void TrackInto(const cv::Mat& previous, const cv::Mat& next, std::vector<Track>*
 // The relative pose frame_k <- frame_0 and the triangulated corners (frame 0 coordinates) of the
 // essential-matrix inliers in front of both cameras.
 struct TwoViewGeometry {
-  cv::Matx33d rotation;
-  cv::Vec3d translation;            // unit length
-  std::vector<int> track_ids;       // the inliers' indices into the tracks
-  std::vector<cv::Point3d> points;  // their triangulated positions
+  Eigen::Matrix3d rotation;
+  Eigen::Vector3d translation;          // unit length
+  std::vector<int> track_ids;           // the inliers' indices into the tracks
+  std::vector<Eigen::Vector3d> points;  // their triangulated positions
   double median_parallax_deg = 0.0;
 };
 
@@ -98,17 +99,16 @@ TwoViewGeometry EstimateTwoViewGeometry(const std::vector<Track>& tracks, const 
   constexpr double kMaxDistanceBaselines = 1000.0;
   cv::recoverPose(E, p0, pk, K, R, t, kMaxDistanceBaselines, mask, points4);
   points4.convertTo(points4, CV_64F);
-  geometry.rotation = cv::Matx33d(R);
-  geometry.translation = cv::Vec3d(t);
+  cv::cv2eigen(R, geometry.rotation);
+  cv::cv2eigen(t, geometry.translation);
   std::vector<double> parallax_deg;
-  const cv::Vec3d centre_k = -(geometry.rotation.t() * geometry.translation);
+  const Eigen::Vector3d centre_k = -geometry.rotation.transpose() * geometry.translation;
   for (int i = 0; i < mask.rows; ++i) {
     if (!mask.at<uchar>(i)) continue;
     const double w = points4.at<double>(3, i);
-    const cv::Point3d X(points4.at<double>(0, i) / w, points4.at<double>(1, i) / w,
-                        points4.at<double>(2, i) / w);
-    const cv::Vec3d ray0(X.x, X.y, X.z), rayk = cv::Vec3d(X.x, X.y, X.z) - centre_k;
-    const double cos_angle = ray0.dot(rayk) / (cv::norm(ray0) * cv::norm(rayk));
+    const Eigen::Vector3d X(points4.at<double>(0, i) / w, points4.at<double>(1, i) / w,
+                            points4.at<double>(2, i) / w);
+    const double cos_angle = X.normalized().dot((X - centre_k).normalized());
     geometry.track_ids.push_back(i);
     geometry.points.push_back(X);
     parallax_deg.push_back(std::acos(std::clamp(cos_angle, -1.0, 1.0)) * 180.0 / M_PI);
@@ -143,7 +143,10 @@ void BundleAdjust(const std::vector<Track>& tracks, const std::vector<int>& trac
                   std::vector<Eigen::Vector3d>* translations,
                   std::vector<Eigen::Vector3d>* points) {
   const int k = static_cast<int>(rotations->size()) - 1;
-  ceres::Problem problem;
+  ceres::HuberLoss loss(kHuberPx);  // one for every residual block
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
   for (int j = 0; j <= k; ++j) {
     problem.AddParameterBlock((*rotations)[j].coeffs().data(), 4,
                               new ceres::EigenQuaternionManifold());
@@ -156,8 +159,8 @@ void BundleAdjust(const std::vector<Track>& tracks, const std::vector<int>& trac
     for (int j = 0; j <= k; ++j) {
       problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ReprojectionError, 2, 4, 3, 3>(
                                    new ReprojectionError(tracks[track_ids[i]].positions[j], K)),
-                               new ceres::HuberLoss(kHuberPx), (*rotations)[j].coeffs().data(),
-                               (*translations)[j].data(), (*points)[i].data());
+                               &loss, (*rotations)[j].coeffs().data(), (*translations)[j].data(),
+                               (*points)[i].data());
     }
   }
   ceres::Solver::Options options;
@@ -230,24 +233,15 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
 
   // Poses of frames 0..k (cam_from_ref) and corners, refined together over every frame.
   const int k = result.second_view;
-  const Eigen::Quaterniond rotation_k = [&] {
-    Eigen::Matrix3d R;
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) R(r, c) = geometry.rotation(r, c);
-    }
-    return Eigen::Quaterniond(R);
-  }();
-  const Eigen::Vector3d translation_k(geometry.translation[0], geometry.translation[1],
-                                      geometry.translation[2]);
+  const Eigen::Quaterniond rotation_k(geometry.rotation);
   std::vector<Eigen::Quaterniond> rotations;
   std::vector<Eigen::Vector3d> translations;
   for (int j = 0; j <= k; ++j) {
     const double f = static_cast<double>(j) / k;
     rotations.push_back(Eigen::Quaterniond::Identity().slerp(f, rotation_k));
-    translations.push_back(f * translation_k);
+    translations.push_back(f * geometry.translation);
   }
-  std::vector<Eigen::Vector3d> points;
-  for (const cv::Point3d& X : geometry.points) points.emplace_back(X.x, X.y, X.z);
+  std::vector<Eigen::Vector3d> points = geometry.points;
   BundleAdjust(tracks, geometry.track_ids, K, &rotations, &translations, &points);
 
   // Scale: median inverse depth of the corners in front of frame 0 is 1.
