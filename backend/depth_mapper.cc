@@ -35,12 +35,15 @@ void DepthMapper::SetKeyframe(const cv::Mat& image, const EdgeTrace& edges) {
   map_ = SemiDenseDepthMap(image.cols, image.rows);
   map_.SelectPixels(keyframe_, edges_.id_map, options_);
   line_in_ref_by_id_.clear();
+  line_cov_in_ref_by_id_.clear();
   for (const TracedLine& line : edges_.lines) {
     if (line.id < 0) continue;
     if (line.id >= static_cast<int>(line_in_ref_by_id_.size())) {
       line_in_ref_by_id_.resize(line.id + 1, Eigen::Vector3d::Zero());
+      line_cov_in_ref_by_id_.resize(line.id + 1, Eigen::Matrix3d::Zero());
     }
     line_in_ref_by_id_[line.id] = line.segment.line;
+    line_cov_in_ref_by_id_[line.id] = line.segment.line_cov;
   }
 }
 
@@ -88,15 +91,22 @@ void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
                         edge < static_cast<int>(lines_in_cur.size()) && lines_in_cur[edge].matched;
   if (has_line) {
     ++stats->line_attempts;
-    // The foot point of the pixel on l1 (the pixel itself when l1 is unknown).
+    // The foot point of the pixel on l1 and l1's position variance there (the pixel itself and
+    // 0 when l1 is unknown).
     Eigen::Vector2d edge_pixel = pixel;
+    double ref_line_position_var = 0.0;
     if (edge < static_cast<int>(line_in_ref_by_id_.size())) {
       const Eigen::Vector3d& l1 = line_in_ref_by_id_[edge];
       edge_pixel -= (l1.x() * pixel.x() + l1.y() * pixel.y() + l1.z()) * l1.head<2>();
+      if (options_.line_stereo_keyframe_line_var) {
+        const Eigen::Vector3d foot(edge_pixel.x(), edge_pixel.y(), 1.0);
+        ref_line_position_var = foot.dot(line_cov_in_ref_by_id_[edge] * foot);
+      }
     }
-    status = LineGuidedStereo(geometry, pixel, edge_pixel, lines_in_cur[edge].line_in_cur,
-                              idepth_min, idepth_max, options_, &current,
-                              patch_status == StereoStatus::kOk ? &patch : nullptr, &observation);
+    status =
+        LineGuidedStereo(geometry, pixel, edge_pixel, ref_line_position_var,
+                         lines_in_cur[edge].line_in_cur, idepth_min, idepth_max, options_, &current,
+                         patch_status == StereoStatus::kOk ? &patch : nullptr, &observation);
     if (status == StereoStatus::kOk) {
       ++stats->line_ok;
       if (options_.line_stereo_refine_ssd && patch_status == StereoStatus::kOk) {
@@ -130,8 +140,11 @@ void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
     ++stats->ssd_ok;
   }
   // Every stereo observation of the pixel (SSD or line-guided) shares part of its error with the
-  // others (options.stereo_error_correlation, SemiDenseDepthMap::Fuse).
-  const double correlation = options_.stereo_error_correlation;
+  // others (options.stereo_error_correlation, SemiDenseDepthMap::Fuse); a line-guided one also
+  // its keyframe edge's error, shared_idepth_var.
+  const double rho = options_.stereo_error_correlation;
+  const double correlation =
+      rho + (1.0 - rho) * observation.shared_idepth_var / observation.idepth_var;
   if (valid) {
     if (map_.Fuse(index, observation.idepth, observation.idepth_var, correlation, options_)) {
       ++stats->fused;

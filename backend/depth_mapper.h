@@ -124,7 +124,8 @@ class DepthMapper {
   ImagePyramid keyframe_;
   EdgeTrace edges_;
   SemiDenseDepthMap map_;
-  std::vector<Eigen::Vector3d> line_in_ref_by_id_;  // keyframe_lines()
+  std::vector<Eigen::Vector3d> line_in_ref_by_id_;      // keyframe_lines()
+  std::vector<Eigen::Matrix3d> line_cov_in_ref_by_id_;  // their Sigma_l1
 };
 
 }  // namespace pldvo

@@ -103,6 +103,9 @@ struct StereoObservation {
   Eigen::Vector2d pixel_in_cur = Eigen::Vector2d::Zero();
   double disparity_var = 0.0;  // pixels^2 along the epipolar line
   double ssd = 0.0;            // 5-sample SSD at the match
+  // The part of idepth_var that every observation of the pixel shares on top of
+  // options.stereo_error_correlation (line-guided: the keyframe edge's error; SSD: 0).
+  double shared_idepth_var = 0.0;
 };
 
 // The exhaustive SSD search along x's epipolar line over [idepth_min, idepth_max] (steps of

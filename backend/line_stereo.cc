@@ -49,7 +49,7 @@ double LineDisparityVar(double line_position_var, double epipolar_position_var, 
 }
 
 StereoStatus LineGuidedStereo(const EpipolarGeometry& geometry, const Eigen::Vector2d& pixel_in_ref,
-                              const Eigen::Vector2d& pixel_on_line,
+                              const Eigen::Vector2d& pixel_on_line, double ref_line_position_var,
                               const LineWithCovariance& line_in_cur, double idepth_min,
                               double idepth_max, const MappingOptions& options,
                               const ImagePyramid* current, const EpipolarPatch* patch,
@@ -88,11 +88,14 @@ StereoStatus LineGuidedStereo(const EpipolarGeometry& geometry, const Eigen::Vec
   const Eigen::Vector3d match_h(match_on_line.x(), match_on_line.y(), 1.0);
   const double line_position_var = match_h.dot(line_in_cur.cov * match_h);
   const double theta = std::asin(std::min(1.0, sin_theta));
-  const double disparity_var = LineDisparityVar(
-      line_position_var, options.sigma_epipolar_px * options.sigma_epipolar_px, theta);
+  const double disparity_var =
+      LineDisparityVar(line_position_var + ref_line_position_var,
+                       options.sigma_epipolar_px * options.sigma_epipolar_px, theta);
+  const double alpha_sq = 1.0 / (jacobian_norm * jacobian_norm);
   observation->idepth = idepth;
   observation->disparity_var = disparity_var;
-  observation->idepth_var = disparity_var / (jacobian_norm * jacobian_norm);
+  observation->idepth_var = disparity_var * alpha_sq;
+  observation->shared_idepth_var = LineDisparityVar(ref_line_position_var, 0.0, theta) * alpha_sq;
   observation->pixel_in_cur = match;
   return StereoStatus::kOk;
 }

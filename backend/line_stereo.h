@@ -10,9 +10,13 @@
 //   l2^T K (R K^-1 (x; 1) / d + t) = 0   =>   d = - l2^T K R K^-1 (x; 1) / (l2^T K t).
 // The disparity along the epipolar line has the variance (eq. 10)
 //   sigma_lambda^2 = sigma_l^2 / sin^2(theta) + sigma_g^2 cot^2(theta),
-// theta the angle between the epipolar line and the edge, sigma_l the edge's perpendicular
-// position error at the match (x'^T Sigma_l x'), sigma_g the epipolar line's (pose) position
-// error; converted to inverse depth by alpha = 1 / |d tau / d d| as in the photometric case.
+// theta the angle between the epipolar line and the edge, sigma_g the epipolar line's (pose)
+// position error, sigma_l the edges' perpendicular position error: that of the current edge at the
+// match, x'^T Sigma_l2 x', plus that of the keyframe edge at x, x^T Sigma_l1 x (a keyframe edge off
+// by delta moves the foot point of x, and so its epipolar line, by delta across the edge, to first
+// order in the small motion); converted to inverse depth by alpha = 1 / |d tau / d d| as in the
+// photometric case. The keyframe edge's part is the same error in every frame: it is returned as
+// the observation's shared variance.
 #ifndef PLDVO_BACKEND_LINE_STEREO_H_
 #define PLDVO_BACKEND_LINE_STEREO_H_
 
@@ -64,9 +68,10 @@ double LineDisparityVar(double line_position_var, double epipolar_position_var, 
 //
 // `pixel_on_line` is the point of l1 whose ray meets the 3D line (the foot point of a traced
 // pixel on l1); the observation's inverse depth is that of the 3D line there, and its current
-// pixel and SSD check are those of `pixel_in_ref` at that inverse depth.
+// pixel and SSD check are those of `pixel_in_ref` at that inverse depth. `ref_line_position_var`
+// is l1's perpendicular position variance there (pixels^2; 0 for an exact keyframe edge).
 StereoStatus LineGuidedStereo(const EpipolarGeometry& geometry, const Eigen::Vector2d& pixel_in_ref,
-                              const Eigen::Vector2d& pixel_on_line,
+                              const Eigen::Vector2d& pixel_on_line, double ref_line_position_var,
                               const LineWithCovariance& line_in_cur, double idepth_min,
                               double idepth_max, const MappingOptions& options,
                               const ImagePyramid* current, const EpipolarPatch* patch,

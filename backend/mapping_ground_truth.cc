@@ -66,6 +66,8 @@ GroundTruthEdges MakeGroundTruthEdges(const std::vector<EdgeSegment>& segments_i
   result.segments_in_ref = segments_in_ref;
   std::vector<LineSegment> segments(segments_in_ref.size());
   std::vector<int> ids;
+  std::mt19937 rng(options.seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
   for (size_t i = 0; i < segments_in_ref.size(); ++i) {
     Eigen::Vector2d p, q;
     if (!ProjectSegment(segments_in_ref[i].start_in_ref, segments_in_ref[i].end_in_ref, camera,
@@ -73,7 +75,11 @@ GroundTruthEdges MakeGroundTruthEdges(const std::vector<EdgeSegment>& segments_i
       continue;
     }
     if ((q - p).norm() < options.min_length_px) continue;
-    segments[i] = MakeLineSegment(p, q, 0, 0.5);
+    if (options.line_sigma_px > 0.0) {
+      p += options.line_sigma_px * DrawVector2(noise, rng);
+      q += options.line_sigma_px * DrawVector2(noise, rng);
+    }
+    segments[i] = MakeLineSegment(p, q, 0, options.line_sigma_px);
     ids.push_back(static_cast<int>(i));
   }
   EdgeTracerOptions tracer_options;

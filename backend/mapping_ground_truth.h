@@ -25,17 +25,22 @@ struct GroundTruthEdgeOptions {
   // A traced pixel is visible when the GT depth in its 3x3 neighbourhood matches the 3D line's
   // depth at the pixel within this relative difference.
   double max_depth_rel_diff = 0.03;
+  // Endpoint noise of the keyframe lines (pixels; 0: exact), their Sigma_l, and its seed. The
+  // traced pixels follow the noisy lines, as the frontend's do.
+  double line_sigma_px = 0.0;
+  uint32_t seed = 0;
 };
 
 struct GroundTruthEdges {
   EdgeTrace trace;                           // ids index segments_in_ref
   std::vector<EdgeSegment> segments_in_ref;  // every input segment (traced or not)
   cv::Mat line_idepth;  // CV_32F: inverse depth of the 3D line at each traced pixel, else 0
-  cv::Mat centre_mask;  // CV_8U: 255 at traced pixels within 0.5 px of the projected line
+  cv::Mat centre_mask;  // CV_8U: 255 at traced pixels within 0.5 px of the keyframe line
 };
 
 // Projects the segments (keyframe frame) into the keyframe, traces them, and keeps the traced
-// pixels whose 3D line point is visible in `depth` (CV_32F z-depth, metres).
+// pixels whose 3D line point is visible in `depth` (CV_32F z-depth, metres). The keyframe lines'
+// endpoints carry options.line_sigma_px of noise (exact by default).
 GroundTruthEdges MakeGroundTruthEdges(const std::vector<EdgeSegment>& segments_in_ref,
                                       const cv::Mat& depth, const PinholeCamera& camera,
                                       const GroundTruthEdgeOptions& options);

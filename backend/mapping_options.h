@@ -81,6 +81,10 @@ struct MappingOptions {
   // idepth +- search_sigmas sigma_lambda (the line disambiguates, the SSD localises); the SSD
   // observation replaces the line one when the search succeeds.
   bool line_stereo_refine_ssd = false;
+  // Add the keyframe line's perpendicular position error at the pixel (x^T Sigma_l1 x) to the
+  // current line's in eq. 10, as a part of the observation's error that every line-guided
+  // observation of the pixel shares (the same keyframe detection in every frame).
+  bool line_stereo_keyframe_line_var = true;
 
   // ---- EKF fusion and outliers (Engel 2013 Sec. 2.3).
   // rho of the correlated-error fusion (SemiDenseDepthMap::Fuse, docs/mapping.md): the fraction
@@ -190,6 +194,9 @@ struct MappingOptions {
             "Check line-guided matches with one 5-sample SSD (default true).");
     v.Field("line_stereo_refine_ssd", &line_stereo_refine_ssd,
             "Refine line-guided matches by an SSD search within +- search_sigmas of them.");
+    v.Field("line_stereo_keyframe_line_var", &line_stereo_keyframe_line_var,
+            "Add the keyframe line's position error to eq. 10, shared by all of the pixel's "
+            "line-guided observations (default true).");
     v.Field("stereo_error_correlation", &stereo_error_correlation,
             "Fraction of a stereo observation's variance shared by all observations of the pixel "
             "(fusion floor; 0 = independent EKF; default 0.1).");

@@ -92,6 +92,7 @@ std::string MapEvalConfig::Check() const {
   if (frame_stride < 1) return "frame_stride must be >= 1";
   if (speed_repetitions < 0) return "speed_repetitions must be >= 0";
   if (line_sigma_px < 0.0) return "line_sigma_px must be >= 0";
+  if (keyframe_line_sigma_px < 0.0) return "keyframe_line_sigma_px must be >= 0";
   if (!(discontinuity_rel_step > 0.0)) return "discontinuity_rel_step must be > 0";
   if (discontinuity_radius_px < 0) return "discontinuity_radius_px must be >= 0";
   const std::string mapping_error = mapping.Check();
@@ -114,9 +115,12 @@ MapEvalResult RunMapEvaluation(const MapEvalConfig& config) {
   for (int k = 1; k <= config.num_frames; ++k) {
     frames.push_back(render(config.keyframe_index + k * config.frame_stride));
   }
+  GroundTruthEdgeOptions edge_options;
+  edge_options.line_sigma_px = config.keyframe_line_sigma_px;
+  edge_options.seed = static_cast<uint32_t>(config.line_seed);
   const GroundTruthEdges gt_edges = MakeGroundTruthEdges(
       synthetic_pairs::SegmentsInCam(sequence.scene, keyframe.world_from_cam.Inverse()),
-      keyframe.depth, sequence.camera, GroundTruthEdgeOptions());
+      keyframe.depth, sequence.camera, edge_options);
   MapEvalResult result;
   result.width = sequence.camera.width;
   result.height = sequence.camera.height;

@@ -27,6 +27,8 @@ struct MapEvalConfig {
   // Further line-guided runs, one per endpoint noise (the accuracy crossover with photometric).
   std::vector<double> line_sigma_sweep = {0.1, 0.5, 1.0};
   int line_seed = 17;
+  // Endpoint noise of the keyframe's GT lines (pixels; 0: exact), seeded by line_seed.
+  double keyframe_line_sigma_px = 0.0;
   // Best of this many timings of the edge stereo with wide priors (0 skips the timing).
   int speed_repetitions = 5;
   // ContinuousDepthMask: a GT inverse-depth step larger than this fraction between 4-neighbours
@@ -49,6 +51,8 @@ struct MapEvalConfig {
     v.Field("frame_stride", &frame_stride, "Frame k is keyframe_index + k * frame_stride.");
     v.Field("line_sigma_px", &line_sigma_px, "Endpoint noise of the GT current lines, pixels.");
     v.Field("line_seed", &line_seed, "Seed of that noise.");
+    v.Field("keyframe_line_sigma_px", &keyframe_line_sigma_px,
+            "Endpoint noise of the keyframe's GT lines, pixels (0: exact).");
     v.Field("speed_repetitions", &speed_repetitions,
             "Best of this many timings of the wide-prior edge stereo (0 skips it).");
     v.Field("discontinuity_rel_step", &discontinuity_rel_step,

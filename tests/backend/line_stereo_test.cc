@@ -1,10 +1,12 @@
 // Line-guided stereo (backend/line_stereo.h): the plane-intersection triangulation of eqs. 8-9 is
-// exact on noiseless geometry, and the disparity variance of eq. 10 matches Monte Carlo sampling.
+// exact on noiseless geometry, and the disparity variance of eq. 10 (both edges' parts) matches
+// Monte Carlo sampling.
 #include "backend/line_stereo.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -76,8 +78,8 @@ TEST(LineStereoTest, ParallelEdgeIsIllConditioned) {
   LineWithCovariance line = FitLine(Eigen::Vector2d(100, 200.2), Eigen::Vector2d(300, 200.4), 0.5);
   MappingOptions options;
   StereoObservation observation;
-  EXPECT_EQ(LineGuidedStereo(geometry, Eigen::Vector2d(200, 200), Eigen::Vector2d(200, 200), line,
-                             0.0, 5.0, options, nullptr, nullptr, &observation),
+  EXPECT_EQ(LineGuidedStereo(geometry, Eigen::Vector2d(200, 200), Eigen::Vector2d(200, 200), 0.0,
+                             line, 0.0, 5.0, options, nullptr, nullptr, &observation),
             StereoStatus::kLineIllConditioned);
 }
 
@@ -133,8 +135,8 @@ TEST(LineStereoTest, IdepthVarianceMatchesMonteCarlo) {
   MappingOptions options;
   options.sigma_epipolar_px = 0.0;  // only the line noise is sampled
   StereoObservation nominal;
-  ASSERT_EQ(LineGuidedStereo(geometry, pixel, pixel, FitLine(c1, c2, sigma_px), 0.0, 5.0, options,
-                             nullptr, nullptr, &nominal),
+  ASSERT_EQ(LineGuidedStereo(geometry, pixel, pixel, 0.0, FitLine(c1, c2, sigma_px), 0.0, 5.0,
+                             options, nullptr, nullptr, &nominal),
             StereoStatus::kOk);
   EXPECT_NEAR(nominal.idepth, 1.0 / point.z(), 1e-3);  // endpoints noise-free here
   std::mt19937 rng(5);
@@ -146,7 +148,7 @@ TEST(LineStereoTest, IdepthVarianceMatchesMonteCarlo) {
     const Eigen::Vector2d q1 = c1 + DrawVector2(noise, rng);
     const Eigen::Vector2d q2 = c2 + DrawVector2(noise, rng);
     StereoObservation observation;
-    if (LineGuidedStereo(geometry, pixel, pixel, FitLine(q1, q2, sigma_px), 0.0, 5.0, options,
+    if (LineGuidedStereo(geometry, pixel, pixel, 0.0, FitLine(q1, q2, sigma_px), 0.0, 5.0, options,
                          nullptr, nullptr, &observation) != StereoStatus::kOk) {
       continue;
     }
@@ -157,6 +159,77 @@ TEST(LineStereoTest, IdepthVarianceMatchesMonteCarlo) {
   ASSERT_EQ(n, kSamples);
   const double mean = sum / n;
   EXPECT_NEAR((sum_sq / n - mean * mean) / nominal.idepth_var, 1.0, 0.10);
+}
+
+// The keyframe edge's part of eq. 10: a traced pixel 0.7 px off the edge is matched from its foot
+// point on a keyframe line fitted through noisy endpoints. Noise on the keyframe endpoints alone
+// must give the observation's shared variance, and noise on both lines its whole variance (same
+// tolerance reasoning as above).
+TEST(LineStereoTest, KeyframeEdgeVarianceMatchesMonteCarlo) {
+  const PinholeCamera camera = TestCamera();
+  const SE3 cur_from_ref = SE3::Exp((Vector6d() << 0.12, 0.03, 0.02, 0.01, -0.02, 0.01).finished());
+  const EpipolarGeometry geometry(camera, cur_from_ref);
+  const Eigen::Vector3d a(-0.4, -0.5, 2.5), b(0.3, 0.6, 2.8);
+  const Eigen::Vector2d k1 = camera.Project(a), k2 = camera.Project(b);
+  const Eigen::Vector2d c1 = camera.Project(cur_from_ref * a),
+                        c2 = camera.Project(cur_from_ref * b);
+  const LineWithCovariance exact_l1 = FitLine(k1, k2, 0.5);
+  const Eigen::Vector2d pixel = k1 + 0.4 * (k2 - k1) + 0.7 * exact_l1.line.head<2>();
+  MappingOptions options;
+  options.sigma_epipolar_px = 0.0;
+  // Foot point of `pixel` on l1 and l1's perpendicular variance there.
+  auto foot_point = [&](const LineWithCovariance& l1, double* var) {
+    const Eigen::Vector2d foot =
+        pixel -
+        (l1.line.x() * pixel.x() + l1.line.y() * pixel.y() + l1.line.z()) * l1.line.head<2>();
+    const Eigen::Vector3d foot_h(foot.x(), foot.y(), 1.0);
+    *var = foot_h.dot(l1.cov * foot_h);
+    return foot;
+  };
+  const double sigma_px = 0.5;
+  double ref_var = 0.0;
+  const Eigen::Vector2d nominal_foot = foot_point(exact_l1, &ref_var);
+  StereoObservation nominal;
+  ASSERT_EQ(LineGuidedStereo(geometry, pixel, nominal_foot, ref_var, FitLine(c1, c2, sigma_px), 0.0,
+                             5.0, options, nullptr, nullptr, &nominal),
+            StereoStatus::kOk);
+  EXPECT_GT(nominal.shared_idepth_var, 0.3 * nominal.idepth_var);
+  EXPECT_LT(nominal.shared_idepth_var, 0.7 * nominal.idepth_var);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, sigma_px);
+  const int kSamples = 20000;
+  for (const bool noisy_current : {false, true}) {
+    double sum = 0.0, sum_sq = 0.0;
+    int n = 0;
+    for (int k = 0; k < kSamples; ++k) {
+      const LineWithCovariance l1 =
+          FitLine(k1 + DrawVector2(noise, rng), k2 + DrawVector2(noise, rng), sigma_px);
+      Eigen::Vector2d q1 = c1, q2 = c2;
+      if (noisy_current) {
+        q1 += DrawVector2(noise, rng);
+        q2 += DrawVector2(noise, rng);
+      }
+      double var = 0.0;
+      const Eigen::Vector2d foot = foot_point(l1, &var);
+      StereoObservation observation;
+      if (LineGuidedStereo(geometry, pixel, foot, var, FitLine(q1, q2, sigma_px), 0.0, 5.0, options,
+                           nullptr, nullptr, &observation) != StereoStatus::kOk) {
+        continue;
+      }
+      sum += observation.idepth;
+      sum_sq += observation.idepth * observation.idepth;
+      ++n;
+    }
+    ASSERT_EQ(n, kSamples);
+    const double mean = sum / n;
+    const double predicted = noisy_current ? nominal.idepth_var : nominal.shared_idepth_var;
+    std::printf("%s noisy: sample / predicted variance %.3f (shared fraction %.3f)\n",
+                noisy_current ? "both lines" : "keyframe line",
+                (sum_sq / n - mean * mean) / predicted,
+                nominal.shared_idepth_var / nominal.idepth_var);
+    EXPECT_NEAR((sum_sq / n - mean * mean) / predicted, 1.0, 0.10)
+        << (noisy_current ? "both lines" : "keyframe line") << " noisy";
+  }
 }
 
 }  // namespace

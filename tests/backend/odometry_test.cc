@@ -225,7 +225,11 @@ TEST(OdometryTest, CompareSolverSolvesTheSameProblemsWithoutChangingTheRun) {
     ASSERT_FALSE(frame.tracking.levels.empty());
     const double run_cost = frame.tracking.levels.back().final_cost;
     EXPECT_NEAR(frame.compared_final_cost, run_cost, 0.01 * run_cost) << "frame " << frame.index;
-    EXPECT_EQ(frame.compared_valid_residuals, frame.tracking.valid_residuals);
+    // A residual is valid where its pixel projects into the image at the final pose, so the two
+    // solvers' final poses (5e-4 apart) may differ by a pixel crossing the border.
+    EXPECT_NEAR(frame.compared_valid_residuals, frame.tracking.valid_residuals,
+                1e-3 * frame.tracking.valid_residuals)
+        << "frame " << frame.index;
     compared.push_back({frame.timestamp, frame.world_from_cam_compared});
   }
   ASSERT_EQ(translation_diff.size(), static_cast<size_t>(kFrames - 1));
