@@ -9,7 +9,9 @@
 
 #include "backend/depth_map_io.h"
 #include "backend/depth_mapper.h"
+#include "backend/reference_builder.h"
 #include "experiments/synthetic_pairs.h"
+#include "frontend/line_frontend.h"
 
 namespace pldvo {
 namespace {
@@ -20,23 +22,29 @@ struct Frame {
   SE3 world_from_cam;
 };
 
+// The keyframe's edges (the mapper's edge candidates) and the truth of the edge statistics.
+struct KeyframeEdges {
+  EdgeTrace trace;
+  cv::Mat idepth;  // CV_32F: GT inverse depth of the evaluated edge pixels
+  cv::Mat mask;    // CV_8U: the evaluated edge pixels
+};
+
+// lines[k]: the matched lines of frames[k], indexed by keyframe edge id.
 MapEvalRun RunVariant(const MapEvalConfig& config, bool line_stereo, double line_sigma_px,
-                      const synthetic::SyntheticSequence& sequence, const Frame& keyframe,
-                      const std::vector<Frame>& frames, const GroundTruthEdges& gt_edges) {
+                      const PinholeCamera& camera, const Frame& keyframe,
+                      const std::vector<Frame>& frames, const KeyframeEdges& edges,
+                      const std::vector<std::vector<MatchedLine>>& lines) {
   MappingOptions options = config.mapping;
   options.use_line_stereo = line_stereo;
-  DepthMapper mapper(sequence.camera, options);
-  mapper.InitializeKeyframe(keyframe.image, gt_edges.trace);
+  DepthMapper mapper(camera, options);
+  mapper.InitializeKeyframe(keyframe.image, edges.trace);
   MapEvalRun run;
   run.line_sigma_px = line_sigma_px;
   double edge_ms = 0.0, other_ms = 0.0;
   long edge_pixels = 0, other_pixels = 0;
   for (size_t k = 0; k < frames.size(); ++k) {
     const SE3 cur_from_ref = frames[k].world_from_cam.Inverse() * keyframe.world_from_cam;
-    const std::vector<MatchedLine> lines =
-        ProjectGroundTruthLines(gt_edges, sequence.camera, cur_from_ref, line_sigma_px,
-                                static_cast<uint32_t>(config.line_seed + k));
-    const FrameUpdateStats stats = mapper.UpdateWithFrame(frames[k].image, cur_from_ref, lines);
+    const FrameUpdateStats stats = mapper.UpdateWithFrame(frames[k].image, cur_from_ref, lines[k]);
     if (k == 0 && stats.num_edge_pixels > 0) {
       run.first_frame_edge_us_per_pixel = 1e3 * stats.edge_stereo_ms / stats.num_edge_pixels;
     }
@@ -65,12 +73,54 @@ MapEvalRun RunVariant(const MapEvalConfig& config, bool line_stereo, double line
   run.continuous = EvaluateDepthMap(map, gt_idepth,
                                     ContinuousDepthMask(gt_idepth, config.discontinuity_radius_px,
                                                         config.discontinuity_rel_step));
-  run.edges = EvaluateDepthMap(map, gt_edges.line_idepth, gt_edges.centre_mask);
+  run.edges = EvaluateDepthMap(map, edges.idepth, edges.mask);
   const SemiDenseDepthMap line_regularized = mapper.RegularizedMap(false, true, &run.line_stats);
-  run.edges_line_regularized =
-      EvaluateDepthMap(line_regularized, gt_edges.line_idepth, gt_edges.centre_mask);
+  run.edges_line_regularized = EvaluateDepthMap(line_regularized, edges.idepth, edges.mask);
   run.all_smoothed = EvaluateDepthMap(mapper.RegularizedMap(true, false), gt_idepth, cv::Mat());
   return run;
+}
+
+// The GT lines of every frame at endpoint noise sigma_px (frame k seeded line_seed + k).
+std::vector<std::vector<MatchedLine>> GroundTruthLinesPerFrame(
+    const MapEvalConfig& config, const GroundTruthEdges& gt_edges, const PinholeCamera& camera,
+    const Frame& keyframe, const std::vector<Frame>& frames, double sigma_px) {
+  std::vector<std::vector<MatchedLine>> lines;
+  for (size_t k = 0; k < frames.size(); ++k) {
+    lines.push_back(ProjectGroundTruthLines(
+        gt_edges, camera, frames[k].world_from_cam.Inverse() * keyframe.world_from_cam, sigma_px,
+        static_cast<uint32_t>(config.line_seed + k)));
+  }
+  return lines;
+}
+
+// frontend_lines: every keyframe segment traced (as the odometry does), every frame's segments
+// matched to the keyframe's without a prediction; the edge statistics on the traced pixels within
+// 0.5 px of their segment that `continuous` keeps, against the depth image.
+void FrontendLines(const MapEvalConfig& config, const Frame& keyframe,
+                   const std::vector<Frame>& frames, const cv::Mat& gt_idepth,
+                   const cv::Mat& continuous, KeyframeEdges* edges,
+                   std::vector<std::vector<MatchedLine>>* lines) {
+  LineFrontend frontend(config.lines);
+  const LineFrame keyframe_lines = frontend.Process(keyframe.image);
+  std::vector<LineMatch> all(keyframe_lines.segments.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i].ref_index = static_cast<int>(i);
+  edges->trace = frontend.TraceMatched(keyframe_lines, all);
+  edges->idepth = gt_idepth;
+  edges->mask = cv::Mat(gt_idepth.size(), CV_8U, cv::Scalar(0));
+  for (const TracedLine& line : edges->trace.lines) {
+    for (const Eigen::Vector2i& p : line.pixels) {
+      if (std::abs(line.segment.SignedDistance(p.cast<double>())) <= 0.5 &&
+          continuous.at<uint8_t>(p.y(), p.x()) != 0) {
+        edges->mask.at<uint8_t>(p.y(), p.x()) = 255;
+      }
+    }
+  }
+  for (const Frame& frame : frames) {
+    const LineFrame frame_lines = frontend.Process(frame.image);
+    lines->push_back(MatchedLinesFromMatches(frontend.Match(keyframe_lines, frame_lines),
+                                             frame_lines.segments,
+                                             static_cast<int>(keyframe_lines.segments.size())));
+  }
 }
 
 }  // namespace
@@ -93,6 +143,11 @@ std::string MapEvalConfig::Check() const {
   if (speed_repetitions < 0) return "speed_repetitions must be >= 0";
   if (line_sigma_px < 0.0) return "line_sigma_px must be >= 0";
   if (keyframe_line_sigma_px < 0.0) return "keyframe_line_sigma_px must be >= 0";
+  if (frontend_lines && !line_sigma_sweep.empty()) {
+    return "frontend_lines needs line_sigma_sweep=[] (the sweep perturbs GT lines)";
+  }
+  const std::string lines_error = lines.Check();
+  if (!lines_error.empty()) return "lines: " + lines_error;
   if (!(discontinuity_rel_step > 0.0)) return "discontinuity_rel_step must be > 0";
   if (discontinuity_radius_px < 0) return "discontinuity_radius_px must be >= 0";
   const std::string mapping_error = mapping.Check();
@@ -121,39 +176,53 @@ MapEvalResult RunMapEvaluation(const MapEvalConfig& config) {
   const GroundTruthEdges gt_edges = MakeGroundTruthEdges(
       synthetic_pairs::SegmentsInCam(sequence.scene, keyframe.world_from_cam.Inverse()),
       keyframe.depth, sequence.camera, edge_options);
+  const PinholeCamera& camera = sequence.camera;
+  const cv::Mat gt_idepth = InverseDepthFromDepth(keyframe.depth);
+  KeyframeEdges edges;
+  std::vector<std::vector<MatchedLine>> lines;  // of the main line-guided run
+  if (config.frontend_lines) {
+    FrontendLines(config, keyframe, frames, gt_idepth,
+                  ContinuousDepthMask(gt_idepth, config.discontinuity_radius_px,
+                                      config.discontinuity_rel_step),
+                  &edges, &lines);
+  } else {
+    edges = {gt_edges.trace, gt_edges.line_idepth, gt_edges.centre_mask};
+    lines =
+        GroundTruthLinesPerFrame(config, gt_edges, camera, keyframe, frames, config.line_sigma_px);
+  }
   MapEvalResult result;
-  result.width = sequence.camera.width;
-  result.height = sequence.camera.height;
-  for (const TracedLine& line : gt_edges.trace.lines) {
-    result.num_gt_edges += !line.pixels.empty();
+  result.width = camera.width;
+  result.height = camera.height;
+  result.frontend_lines = config.frontend_lines;
+  for (const TracedLine& line : edges.trace.lines) {
+    result.num_edges += !line.pixels.empty();
     result.num_edge_pixels += static_cast<int>(line.pixels.size());
   }
   result.baseline_m =
       (frames.back().world_from_cam.translation() - keyframe.world_from_cam.translation()).norm();
-  result.photometric = RunVariant(config, false, 0.0, sequence, keyframe, frames, gt_edges);
+  result.photometric = RunVariant(config, false, 0.0, camera, keyframe, frames, edges, lines);
   result.line_guided =
-      RunVariant(config, true, config.line_sigma_px, sequence, keyframe, frames, gt_edges);
+      RunVariant(config, true, config.line_sigma_px, camera, keyframe, frames, edges, lines);
   for (double sigma : config.line_sigma_sweep) {
     if (sigma < 0.0) throw std::invalid_argument("MapEvalConfig: line_sigma_sweep must be >= 0");
     result.line_sweep.push_back(
-        RunVariant(config, true, sigma, sequence, keyframe, frames, gt_edges));
+        RunVariant(config, true, sigma, camera, keyframe, frames, edges,
+                   GroundTruthLinesPerFrame(config, gt_edges, camera, keyframe, frames, sigma)));
   }
 
   // Edge stereo speed with wide priors: one update of the random initialisation with the last
   // frame.
   if (config.speed_repetitions > 0) {
     const SE3 cur_from_ref = frames.back().world_from_cam.Inverse() * keyframe.world_from_cam;
-    const std::vector<MatchedLine> lines = ProjectGroundTruthLines(
-        gt_edges, sequence.camera, cur_from_ref, config.line_sigma_px, config.line_seed);
     for (int variant = 0; variant < 2; ++variant) {
       MappingOptions options = config.mapping;
       options.use_line_stereo = variant == 1;
       double best = 1e30;
       for (int repetition = 0; repetition < config.speed_repetitions; ++repetition) {
-        DepthMapper mapper(sequence.camera, options);
-        mapper.InitializeKeyframe(keyframe.image, gt_edges.trace);
+        DepthMapper mapper(camera, options);
+        mapper.InitializeKeyframe(keyframe.image, edges.trace);
         const FrameUpdateStats stats =
-            mapper.UpdateWithFrame(frames.back().image, cur_from_ref, lines);
+            mapper.UpdateWithFrame(frames.back().image, cur_from_ref, lines.back());
         if (stats.num_edge_pixels > 0) {
           best = std::min(best, 1e3 * stats.edge_stereo_ms / stats.num_edge_pixels);
         }
@@ -162,14 +231,11 @@ MapEvalResult RunMapEvaluation(const MapEvalConfig& config) {
     }
   }
   // Propagation of the line-guided map to the last frame.
-  DepthMapper mapper(sequence.camera, config.mapping);
-  mapper.InitializeKeyframe(keyframe.image, gt_edges.trace);
+  DepthMapper mapper(camera, config.mapping);
+  mapper.InitializeKeyframe(keyframe.image, edges.trace);
   for (size_t k = 0; k < frames.size(); ++k) {
-    const SE3 cur_from_ref = frames[k].world_from_cam.Inverse() * keyframe.world_from_cam;
-    mapper.UpdateWithFrame(
-        frames[k].image, cur_from_ref,
-        ProjectGroundTruthLines(gt_edges, sequence.camera, cur_from_ref, config.line_sigma_px,
-                                static_cast<uint32_t>(config.line_seed + k)));
+    mapper.UpdateWithFrame(frames[k].image,
+                           frames[k].world_from_cam.Inverse() * keyframe.world_from_cam, lines[k]);
   }
   if (!config.out_dir.empty()) {
     std::filesystem::create_directories(config.out_dir);
@@ -195,10 +261,11 @@ std::string FormatMapEvalTable(const MapEvalResult& r) {
   std::ostringstream out;
   char line[512];
   std::snprintf(line, sizeof(line),
-                "mapeval: %dx%d, %d GT edges (%d traced pixels), keyframe-to-last baseline %.3f m\n"
+                "mapeval: %dx%d, %d %s edges (%d traced pixels), keyframe-to-last baseline %.3f m\n"
                 "rel. err = median |d - d_gt| / d_gt; NEES = (d - d_gt)^2 / V (consistent: mean 1, "
                 "median 0.455, 95.4%% within 2 sigma)\n",
-                r.width, r.height, r.num_gt_edges, r.num_edge_pixels, r.baseline_m);
+                r.width, r.height, r.num_edges, r.frontend_lines ? "frontend" : "GT",
+                r.num_edge_pixels, r.baseline_m);
   out << line;
   out << "| stereo | line sigma px | hyp. | rel. err | mean NEES | median NEES | in 2 sigma | "
          "edge px | edge rel. err | edge mean NEES | edge median NEES | edge rel. err after 3D "
@@ -209,7 +276,11 @@ std::string FormatMapEvalTable(const MapEvalResult& r) {
   for (size_t v = 0; v < runs.size(); ++v) {
     const MapEvalRun& run = *runs[v];
     char sigma[32];
-    std::snprintf(sigma, sizeof(sigma), v == 0 ? "-" : "%.2f", run.line_sigma_px);
+    std::snprintf(sigma, sizeof(sigma),
+                  v == 0             ? "-"
+                  : r.frontend_lines ? "frontend"
+                                     : "%.2f",
+                  run.line_sigma_px);
     std::snprintf(line, sizeof(line),
                   "| %s | %s | %d | %.4f | %.2f | %.3f | %.3f | %d | %.4f | %.2f | %.3f | %.4f | "
                   "%.3f | %.4f | %.2f | %.2f |\n",
@@ -233,7 +304,11 @@ std::string FormatMapEvalTable(const MapEvalResult& r) {
   for (size_t v = 0; v < runs.size(); ++v) {
     const MapEvalRun& run = *runs[v];
     char sigma[32];
-    std::snprintf(sigma, sizeof(sigma), v == 0 ? "-" : "%.2f", run.line_sigma_px);
+    std::snprintf(sigma, sizeof(sigma),
+                  v == 0             ? "-"
+                  : r.frontend_lines ? "frontend"
+                                     : "%.2f",
+                  run.line_sigma_px);
     const DepthErrorStats& c = run.continuous;
     const DepthErrorStats& e = run.edges;
     const DepthErrorStats& l = run.edges_line_regularized;

@@ -2,8 +2,9 @@
 // synthetic sequence with ground-truth poses and depth; a keyframe initialised at random is
 // mapped with N tracked frames (GT poses) twice, with photometric stereo alone and with
 // line-guided stereo (GT line matches: the scene's 3D edges projected with the GT poses, endpoint
-// noise line_sigma_px); then the 3D line regularisation, the smoothing and the propagation to the
-// last frame are evaluated. See docs/mapping.md.
+// noise line_sigma_px; or, with frontend_lines, the line frontend's own detections and matches);
+// then the 3D line regularisation, the smoothing and the propagation to the last frame are
+// evaluated. See docs/mapping.md.
 #ifndef PLDVO_EXPERIMENTS_MAPPING_EVALUATION_H_
 #define PLDVO_EXPERIMENTS_MAPPING_EVALUATION_H_
 
@@ -14,6 +15,7 @@
 #include "backend/mapping_ground_truth.h"
 #include "backend/mapping_options.h"
 #include "core/synthetic/synthetic_sequence.h"
+#include "frontend/line_frontend_options.h"
 
 namespace pldvo {
 
@@ -29,6 +31,11 @@ struct MapEvalConfig {
   int line_seed = 17;
   // Endpoint noise of the keyframe's GT lines (pixels; 0: exact), seeded by line_seed.
   double keyframe_line_sigma_px = 0.0;
+  // The keyframe's edges and every frame's matched lines from the line frontend (`lines`) instead
+  // of the GT edges; the edge statistics are then the frontend's traced centre pixels away from
+  // GT depth discontinuities against the depth image. Needs an empty line_sigma_sweep.
+  bool frontend_lines = false;
+  LineFrontendOptions lines;
   // Best of this many timings of the edge stereo with wide priors (0 skips the timing).
   int speed_repetitions = 5;
   // ContinuousDepthMask: a GT inverse-depth step larger than this fraction between 4-neighbours
@@ -61,8 +68,12 @@ struct MapEvalConfig {
             "Pixels this close to a GT discontinuity are not `continuous`.");
     v.Field("line_sigma_sweep", &line_sigma_sweep,
             "Endpoint noises of additional line-guided runs, pixels.");
+    v.Field("frontend_lines", &frontend_lines,
+            "Edges and line matches from the line frontend instead of GT (needs "
+            "line_sigma_sweep=[]).");
     v.Section("synth", &synth, "Synthetic sequence.");
     v.Section("mapping", &mapping, "Mapping options.");
+    v.Section("lines", &lines, "Line frontend (frontend_lines only).");
   }
   std::string Check() const;
 };
@@ -85,7 +96,8 @@ struct MapEvalRun {
 };
 
 struct MapEvalResult {
-  int width = 0, height = 0, num_gt_edges = 0, num_edge_pixels = 0;
+  bool frontend_lines = false;  // the edges below are the frontend's (else the GT edges)
+  int width = 0, height = 0, num_edges = 0, num_edge_pixels = 0;
   double baseline_m = 0.0;  // keyframe-to-last-frame distance
   MapEvalRun photometric;
   MapEvalRun line_guided;              // at config.line_sigma_px
