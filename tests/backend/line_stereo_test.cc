@@ -27,6 +27,27 @@ Eigen::Vector3d ProjectLine(const PinholeCamera& camera, const Eigen::Vector3d& 
   return l / l.head<2>().norm();
 }
 
+// The sample variance of the inverse depths of `samples` line-guided observations, each made by
+// observe(&observation); every one must succeed.
+template <class Observe>
+double IdepthSampleVariance(int samples, Observe observe) {
+  double sum = 0.0, sum_sq = 0.0;
+  int failed = 0;
+  for (int k = 0; k < samples; ++k) {
+    StereoObservation observation;
+    if (observe(&observation) != StereoStatus::kOk) {
+      ++failed;
+      continue;
+    }
+    sum += observation.idepth;
+    sum_sq += observation.idepth * observation.idepth;
+  }
+  EXPECT_EQ(failed, 0);
+  const int n = samples - failed;
+  const double mean = sum / n;
+  return sum_sq / n - mean * mean;
+}
+
 TEST(LineStereoTest, PlaneIntersectionIsExactOnNoiselessGeometry) {
   const PinholeCamera camera = TestCamera();
   std::mt19937 rng(3);
@@ -141,24 +162,13 @@ TEST(LineStereoTest, IdepthVarianceMatchesMonteCarlo) {
   EXPECT_NEAR(nominal.idepth, 1.0 / point.z(), 1e-3);  // endpoints noise-free here
   std::mt19937 rng(5);
   std::normal_distribution<double> noise(0.0, sigma_px);
-  const int kSamples = 20000;
-  double sum = 0.0, sum_sq = 0.0;
-  int n = 0;
-  for (int k = 0; k < kSamples; ++k) {
+  const double sample_var = IdepthSampleVariance(20000, [&](StereoObservation* observation) {
     const Eigen::Vector2d q1 = c1 + DrawVector2(noise, rng);
     const Eigen::Vector2d q2 = c2 + DrawVector2(noise, rng);
-    StereoObservation observation;
-    if (LineGuidedStereo(geometry, pixel, pixel, 0.0, FitLine(q1, q2, sigma_px), 0.0, 5.0, options,
-                         nullptr, nullptr, &observation) != StereoStatus::kOk) {
-      continue;
-    }
-    sum += observation.idepth;
-    sum_sq += observation.idepth * observation.idepth;
-    ++n;
-  }
-  ASSERT_EQ(n, kSamples);
-  const double mean = sum / n;
-  EXPECT_NEAR((sum_sq / n - mean * mean) / nominal.idepth_var, 1.0, 0.10);
+    return LineGuidedStereo(geometry, pixel, pixel, 0.0, FitLine(q1, q2, sigma_px), 0.0, 5.0,
+                            options, nullptr, nullptr, observation);
+  });
+  EXPECT_NEAR(sample_var / nominal.idepth_var, 1.0, 0.10);
 }
 
 // The keyframe edge's part of eq. 10: a traced pixel 0.7 px off the edge is matched from its foot
@@ -197,11 +207,8 @@ TEST(LineStereoTest, KeyframeEdgeVarianceMatchesMonteCarlo) {
   EXPECT_LT(nominal.shared_idepth_var, 0.7 * nominal.idepth_var);
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0.0, sigma_px);
-  const int kSamples = 20000;
   for (const bool noisy_current : {false, true}) {
-    double sum = 0.0, sum_sq = 0.0;
-    int n = 0;
-    for (int k = 0; k < kSamples; ++k) {
+    const double sample_var = IdepthSampleVariance(20000, [&](StereoObservation* observation) {
       const LineWithCovariance l1 =
           FitLine(k1 + DrawVector2(noise, rng), k2 + DrawVector2(noise, rng), sigma_px);
       Eigen::Vector2d q1 = c1, q2 = c2;
@@ -211,24 +218,15 @@ TEST(LineStereoTest, KeyframeEdgeVarianceMatchesMonteCarlo) {
       }
       double var = 0.0;
       const Eigen::Vector2d foot = foot_point(l1, &var);
-      StereoObservation observation;
-      if (LineGuidedStereo(geometry, pixel, foot, var, FitLine(q1, q2, sigma_px), 0.0, 5.0, options,
-                           nullptr, nullptr, &observation) != StereoStatus::kOk) {
-        continue;
-      }
-      sum += observation.idepth;
-      sum_sq += observation.idepth * observation.idepth;
-      ++n;
-    }
-    ASSERT_EQ(n, kSamples);
-    const double mean = sum / n;
-    const double predicted = noisy_current ? nominal.idepth_var : nominal.shared_idepth_var;
-    std::printf("%s noisy: sample / predicted variance %.3f (shared fraction %.3f)\n",
-                noisy_current ? "both lines" : "keyframe line",
-                (sum_sq / n - mean * mean) / predicted,
+      return LineGuidedStereo(geometry, pixel, foot, var, FitLine(q1, q2, sigma_px), 0.0, 5.0,
+                              options, nullptr, nullptr, observation);
+    });
+    const double ratio =
+        sample_var / (noisy_current ? nominal.idepth_var : nominal.shared_idepth_var);
+    const char* noisy = noisy_current ? "both lines" : "keyframe line";
+    std::printf("%s noisy: sample / predicted variance %.3f (shared fraction %.3f)\n", noisy, ratio,
                 nominal.shared_idepth_var / nominal.idepth_var);
-    EXPECT_NEAR((sum_sq / n - mean * mean) / predicted, 1.0, 0.10)
-        << (noisy_current ? "both lines" : "keyframe line") << " noisy";
+    EXPECT_NEAR(ratio, 1.0, 0.10) << noisy << " noisy";
   }
 }
 
