@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "backend/depth_map_io.h"
@@ -123,6 +124,15 @@ void FrontendLines(const MapEvalConfig& config, const Frame& keyframe,
   }
 }
 
+// The "line sigma px" cell of run v of `r` (run 0 is the photometric one).
+std::string LineSigmaCell(const MapEvalResult& r, size_t v, double line_sigma_px) {
+  if (v == 0) return "-";
+  if (r.frontend_lines) return "frontend";
+  char cell[32];
+  std::snprintf(cell, sizeof(cell), "%.2f", line_sigma_px);
+  return cell;
+}
+
 }  // namespace
 
 MapEvalConfig::MapEvalConfig() {
@@ -145,6 +155,9 @@ std::string MapEvalConfig::Check() const {
   if (keyframe_line_sigma_px < 0.0) return "keyframe_line_sigma_px must be >= 0";
   if (frontend_lines && !line_sigma_sweep.empty()) {
     return "frontend_lines needs line_sigma_sweep=[] (the sweep perturbs GT lines)";
+  }
+  if (frontend_lines && keyframe_line_sigma_px > 0.0) {
+    return "keyframe_line_sigma_px perturbs GT lines, which frontend_lines does not use";
   }
   const std::string lines_error = lines.Check();
   if (!lines_error.empty()) return "lines: " + lines_error;
@@ -275,16 +288,11 @@ std::string FormatMapEvalTable(const MapEvalResult& r) {
   for (const MapEvalRun& run : r.line_sweep) runs.push_back(&run);
   for (size_t v = 0; v < runs.size(); ++v) {
     const MapEvalRun& run = *runs[v];
-    char sigma[32];
-    std::snprintf(sigma, sizeof(sigma),
-                  v == 0             ? "-"
-                  : r.frontend_lines ? "frontend"
-                                     : "%.2f",
-                  run.line_sigma_px);
+    const std::string sigma = LineSigmaCell(r, v, run.line_sigma_px);
     std::snprintf(line, sizeof(line),
                   "| %s | %s | %d | %.4f | %.2f | %.3f | %.3f | %d | %.4f | %.2f | %.3f | %.4f | "
                   "%.3f | %.4f | %.2f | %.2f |\n",
-                  v == 0 ? "photometric" : "line-guided", sigma, run.all.count,
+                  v == 0 ? "photometric" : "line-guided", sigma.c_str(), run.all.count,
                   run.all.median_rel_error, run.all.mean_nees, run.all.median_nees,
                   run.all.within_2sigma, run.edges.count, run.edges.median_rel_error,
                   run.edges.mean_nees, run.edges.median_nees,
@@ -303,19 +311,14 @@ std::string FormatMapEvalTable(const MapEvalResult& r) {
          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (size_t v = 0; v < runs.size(); ++v) {
     const MapEvalRun& run = *runs[v];
-    char sigma[32];
-    std::snprintf(sigma, sizeof(sigma),
-                  v == 0             ? "-"
-                  : r.frontend_lines ? "frontend"
-                                     : "%.2f",
-                  run.line_sigma_px);
+    const std::string sigma = LineSigmaCell(r, v, run.line_sigma_px);
     const DepthErrorStats& c = run.continuous;
     const DepthErrorStats& e = run.edges;
     const DepthErrorStats& l = run.edges_line_regularized;
     std::snprintf(line, sizeof(line),
                   "| %s | %s | %.2f | %.2f%% | %.3f | %d | %.2f | %.3f | %.3f | %.2f%% | %.3f | "
                   "%.2f | %.2f%% | %.3f | %.2f%% | %.3f |\n",
-                  v == 0 ? "photometric" : "line-guided", sigma, run.all.mean_nees,
+                  v == 0 ? "photometric" : "line-guided", sigma.c_str(), run.all.mean_nees,
                   100.0 * run.all.gross_fraction, run.all.bulk_mean_nees, c.count, c.mean_nees,
                   c.median_nees, c.within_2sigma, 100.0 * c.gross_fraction, c.bulk_mean_nees,
                   e.mean_nees, 100.0 * e.gross_fraction, e.bulk_mean_nees, 100.0 * l.gross_fraction,

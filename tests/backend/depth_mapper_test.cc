@@ -254,7 +254,10 @@ TEST(DepthMapperTest, FrontendLinesGuideTheStereoOnLowTexture) {
   EXPECT_LT(r.line_guided.edges.median_rel_error, r.photometric.edges.median_rel_error);
   EXPECT_LT(r.line_guided.continuous.mean_nees, 1.5);
   EXPECT_LT(r.line_guided.edges.gross_fraction, 0.02);
-  // The sweep perturbs GT lines, which this mode does not have.
+  // The sweep and the keyframe line noise perturb GT lines, which this mode does not have.
+  config.keyframe_line_sigma_px = 0.5;
+  EXPECT_THROW(RunMapEvaluation(config), std::invalid_argument);
+  config.keyframe_line_sigma_px = 0.0;
   config.line_sigma_sweep = {0.5};
   EXPECT_THROW(RunMapEvaluation(config), std::invalid_argument);
 }
