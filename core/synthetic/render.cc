@@ -4,7 +4,9 @@
 //   L = 255 a (ambient + light_intensity max(0, n . (l - p) / |l - p|) min(1.4, 2.5 / |l - p|))
 // (a softened 1/d falloff, normalised to 1 at 2.5 m). The image is
 //   I = gain(t) V(r) L + bias(t) + n,  n ~ N(0, noise_sigma^2),
-// rounded and clamped to [0, 255], with V(r) = 1 - s (r / r_corner)^2 the vignetting.
+// rounded and clamped to [0, 255], with V(r) = 1 - s (r / r_corner)^2 the vignetting. With
+// texture_filter_sigma_px > 0 the albedo pattern is band-limited by a Gaussian pixel response,
+// carried onto the surface by ray differentials (PixelFootprint).
 // Pass 1 casts one ray through each pixel centre and records the surface (primitive, face) and
 // z-depth; pass 2 re-renders pixels whose 8-neighbourhood holds another surface with n x n
 // sub-pixel rays (anti-aliasing). Each 16x16 tile only tests the boxes that meet the tile's
@@ -29,6 +31,7 @@ struct ShadingParams {
   double light_intensity;
   double texture_contrast;
   double albedo_variation;
+  double texture_filter_sigma_px;
   Eigen::Vector3d light_in_world;
 };
 
@@ -75,6 +78,15 @@ class Renderer {
     std::vector<int> surface(n);
     const Eigen::Matrix3d rotation = world_from_cam.rotation_matrix();
     const Eigen::Vector3d origin = world_from_cam.translation();
+    // Change of the (z = 1) ray direction per pixel along x and y, in the world frame.
+    const Eigen::Vector3d centre_ray = camera_.Unproject(Eigen::Vector2d::Zero());
+    const Eigen::Vector3d ray_per_x =
+        rotation * (camera_.Unproject(Eigen::Vector2d::UnitX()) - centre_ray);
+    const Eigen::Vector3d ray_per_y =
+        rotation * (camera_.Unproject(Eigen::Vector2d::UnitY()) - centre_ray);
+    const auto shade = [&](const Scene::Hit& hit, const Eigen::Vector3d& direction) {
+      return Shade(hit, origin, direction, ray_per_x, ray_per_y);
+    };
     const int tile_count = tiles_x_ * tiles_y_;
     // Pass 1: pixel centres.
     ParallelFor(tile_count, threads_, [&](int tile) {
@@ -90,7 +102,7 @@ class Renderer {
           const Eigen::Vector3d direction = rotation * camera_.Unproject(Eigen::Vector2d(x, y));
           if (scene_.IntersectSubset(origin, direction, candidates.data(),
                                      static_cast<int>(candidates.size()), &hit)) {
-            radiance[i] = static_cast<float>(Shade(hit, origin, direction));
+            radiance[i] = static_cast<float>(shade(hit, direction));
             depth[i] = static_cast<float>(hit.t);  // the ray has z = 1 in the camera frame
             surface[i] = hit.primitive * 6 + hit.face;
           } else {
@@ -140,7 +152,7 @@ class Renderer {
               Scene::Hit hit;
               if (scene_.IntersectSubset(origin, direction, pixel_candidates.data(),
                                          static_cast<int>(pixel_candidates.size()), &hit)) {
-                sum += Shade(hit, origin, direction);
+                sum += shade(hit, direction);
               }
             }
           }
@@ -160,11 +172,16 @@ class Renderer {
     *y1 = std::min(*y0 + kTile, camera_.height);
   }
 
+  // Radiance of the hit; ray_per_x, ray_per_y: the ray's change per pixel (for the footprint).
   double Shade(const Scene::Hit& hit, const Eigen::Vector3d& origin,
-               const Eigen::Vector3d& direction) const {
+               const Eigen::Vector3d& direction, const Eigen::Vector3d& ray_per_x,
+               const Eigen::Vector3d& ray_per_y) const {
     const Eigen::Vector3d point = origin + hit.t * direction;
+    const PixelFootprint footprint =
+        PixelFootprint::OnPlane(hit.normal_in_world, direction, hit.t, ray_per_x, ray_per_y,
+                                shading_.texture_filter_sigma_px);
     const double albedo =
-        scene_.Albedo(hit, point, shading_.texture_contrast, shading_.albedo_variation);
+        scene_.Albedo(hit, point, shading_.texture_contrast, shading_.albedo_variation, footprint);
     const Eigen::Vector3d to_light = shading_.light_in_world - point;
     const double distance = std::max(to_light.norm(), 1e-6);
     const double cosine = std::max(0.0, hit.normal_in_world.dot(to_light) / distance);
@@ -183,8 +200,8 @@ class Renderer {
 
 ShadingParams MakeShading(const SyntheticSequence& sequence, const Lighting& lighting) {
   const SynthOptions& o = sequence.options;
-  return {o.ambient, o.light_intensity, o.texture_contrast, o.albedo_variation,
-          lighting.light_in_world};
+  return {o.ambient,          o.light_intensity,         o.texture_contrast,
+          o.albedo_variation, o.texture_filter_sigma_px, lighting.light_in_world};
 }
 
 RenderedFrame AllocateFrame(const PinholeCamera& camera) {

@@ -494,44 +494,128 @@ double Scene::DistanceToSurfaces(const Eigen::Vector3d& point_in_world) const {
   return distance;
 }
 
+namespace {
+
+// Band-limiting by the pixel response (PixelFootprint). A Gaussian of sigma pixels
+// multiplies a sinusoid whose phase advances fx, fy cycles per pixel by its Fourier transform,
+// exp(-2 pi^2 sigma^2 (fx^2 + fy^2)); `value` is pulled towards the pattern's `mean` by that
+// factor.
+double Attenuated(double value, double mean, double sigma_px, double fx, double fy) {
+  if (sigma_px <= 0.0) return value;
+  return mean +
+         std::exp(-2.0 * M_PI * M_PI * sigma_px * sigma_px * (fx * fx + fy * fy)) * (value - mean);
+}
+
+// RMS frequency of value noise along one axis, cycles per lattice cell: the spectrum of a
+// linearly interpolated lattice of i.i.d. values is sinc^4(f), whose second moment gives
+// f_rms^2 = (1 / (2 pi^2)) / (2 / 3). The smoothstep interpolation of ValueNoise is treated
+// alike; PixelFootprintTest measures the approximation against brute-force integration.
+const double kValueNoiseRmsCycles = std::sqrt(3.0) / (2.0 * M_PI);
+
+// Value noise at lattice coordinates (x, y), band-limited: its variance falls as
+// exp(-4 pi^2 f_rms^2 tr(C)) to second order, C the footprint's covariance in lattice cells;
+// cells_per_x, cells_per_y are the lattice cells crossed per pixel along x and y.
+double FilteredValueNoise(double x, double y, uint32_t seed, double sigma_px, double cells_per_x,
+                          double cells_per_y) {
+  const double value = internal::ValueNoise(x, y, seed);
+  return Attenuated(value, 0.5, sigma_px, kValueNoiseRmsCycles * cells_per_x,
+                    kValueNoiseRmsCycles * cells_per_y);
+}
+
+// Fraction of a Gaussian of standard deviation `sigma` (face units) around r in [0, period)
+// that falls on the bands [k period, k period + width): the nearest two bands.
+double BandCoverage(double r, double period, double width, double sigma) {
+  if (sigma <= 0.0) return r < width ? 1.0 : 0.0;
+  const auto cdf = [sigma](double x) { return 0.5 * std::erfc(-x / (sigma * M_SQRT2)); };
+  return cdf(width - r) - cdf(-r) + cdf(period + width - r) - cdf(period - r);
+}
+
+}  // namespace
+
+PixelFootprint PixelFootprint::OnPlane(const Eigen::Vector3d& normal,
+                                       const Eigen::Vector3d& direction, double t,
+                                       const Eigen::Vector3d& ray_per_x,
+                                       const Eigen::Vector3d& ray_per_y, double sigma_px) {
+  PixelFootprint footprint;
+  footprint.sigma_px = sigma_px;
+  if (sigma_px <= 0.0) return footprint;
+  // n . d kept 1e-9 away from 0 (a ray along the plane): the footprint is then so wide that the
+  // pattern takes its mean, and finite.
+  double n_d = normal.dot(direction);
+  if (std::abs(n_d) < 1e-9) n_d = std::copysign(1e-9, n_d);
+  footprint.point_per_x = t * (ray_per_x - direction * (normal.dot(ray_per_x) / n_d));
+  footprint.point_per_y = t * (ray_per_y - direction * (normal.dot(ray_per_y) / n_d));
+  return footprint;
+}
+
 double Scene::Albedo(const Hit& hit, const Eigen::Vector3d& point_in_world, double texture_contrast,
-                     double albedo_variation) const {
+                     double albedo_variation, const PixelFootprint& footprint) const {
   const Primitive& p = primitives_[hit.primitive];
   const int axis = hit.face / 2;
+  const int iu = (axis + 1) % 3, iv = (axis + 2) % 3;
   // Face coordinates: the two box-frame coordinates across the face, from the box corner.
   const Eigen::Vector3d q =
       p.box_from_world_rotation * (point_in_world - p.center_in_world) + p.half_size;
-  const double u = q[(axis + 1) % 3], v = q[(axis + 2) % 3];
+  const double u = q[iu], v = q[iv];
+  const double sigma = footprint.sigma_px;
+  Eigen::Vector2d uv_per_x = Eigen::Vector2d::Zero(), uv_per_y = Eigen::Vector2d::Zero();
+  if (sigma > 0.0) {
+    const Eigen::Vector3d dx = p.box_from_world_rotation * footprint.point_per_x;
+    const Eigen::Vector3d dy = p.box_from_world_rotation * footprint.point_per_y;
+    uv_per_x = Eigen::Vector2d(dx[iu], dx[iv]);
+    uv_per_y = Eigen::Vector2d(dy[iu], dy[iv]);
+  }
   double factor = 1.0;
   const uint32_t seed = p.texture_seed + 7919u * static_cast<uint32_t>(hit.face);
   if (texture_contrast > 0.0) {
     const double s = p.texture_scale;
+    // Texture cells (of size s) crossed per pixel along x and y.
+    const double cells_x = uv_per_x.norm() / s, cells_y = uv_per_y.norm() / s;
     double w = 0.5;
     switch (p.pattern[hit.face]) {
       case Pattern::kPlain:
         w = 0.5;
         break;
       case Pattern::kNoise:
-        w = internal::FractalNoise(u / s, v / s, seed);
+        // Three octaves of value noise (fractal noise, in [0, 1]), each band-limited.
+        w = (4.0 * FilteredValueNoise(u / s, v / s, seed, sigma, cells_x, cells_y) +
+             2.0 * FilteredValueNoise(2.03 * (u / s), 2.03 * (v / s), seed + 1, sigma,
+                                      2.03 * cells_x, 2.03 * cells_y) +
+             FilteredValueNoise(4.07 * (u / s), 4.07 * (v / s), seed + 2, sigma, 4.07 * cells_x,
+                                4.07 * cells_y)) /
+            7.0;
         break;
       case Pattern::kWood: {
-        // Bands across v, warped by low-frequency noise.
-        const double warp = 1.5 * internal::ValueNoise(u / (6.0 * s), v / (6.0 * s), seed);
-        w = 0.5 + 0.5 * std::sin(2.0 * M_PI * (v / s + warp));
-        w = 0.7 * w + 0.3 * internal::ValueNoise(u / s, v / s, seed + 3);
+        // Bands across v, warped by low-frequency noise; the band's local frequency is the
+        // phase difference across the footprint.
+        const auto phase = [&](double pu, double pv) {
+          return pv / s + 1.5 * internal::ValueNoise(pu / (6.0 * s), pv / (6.0 * s), seed);
+        };
+        double band = 0.5 + 0.5 * std::sin(2.0 * M_PI * phase(u, v));
+        if (sigma > 0.0) {
+          const auto cycles = [&](const Eigen::Vector2d& d) {
+            return phase(u + 0.5 * d.x(), v + 0.5 * d.y()) -
+                   phase(u - 0.5 * d.x(), v - 0.5 * d.y());
+          };
+          band = Attenuated(band, 0.5, sigma, cycles(uv_per_x), cycles(uv_per_y));
+        }
+        w = 0.7 * band + 0.3 * FilteredValueNoise(u / s, v / s, seed + 3, sigma, cells_x, cells_y);
         break;
       }
       case Pattern::kTiles: {
+        // Tiles of one lattice value each, with dark grout: its coverage of the footprint.
         const double tile = 3.0 * s, grout = 0.012;
-        const double fu = Frac(u / tile), fv = Frac(v / tile);
-        if (fu * tile < grout || fv * tile < grout) {
-          w = 0.0;
-        } else {
-          w = 0.25 +
-              0.5 * internal::LatticeValue(static_cast<int64_t>(std::floor(u / tile)),
-                                           static_cast<int64_t>(std::floor(v / tile)), seed) +
-              0.25 * internal::ValueNoise(u / (0.3 * s), v / (0.3 * s), seed + 5);
-        }
+        const double cover_u = BandCoverage(Frac(u / tile) * tile, tile, grout,
+                                            sigma * std::hypot(uv_per_x.x(), uv_per_y.x()));
+        const double cover_v = BandCoverage(Frac(v / tile) * tile, tile, grout,
+                                            sigma * std::hypot(uv_per_x.y(), uv_per_y.y()));
+        const double face =
+            0.25 +
+            0.5 * internal::LatticeValue(static_cast<int64_t>(std::floor(u / tile)),
+                                         static_cast<int64_t>(std::floor(v / tile)), seed) +
+            0.25 * FilteredValueNoise(u / (0.3 * s), v / (0.3 * s), seed + 5, sigma, cells_x / 0.3,
+                                      cells_y / 0.3);
+        w = (1.0 - cover_u) * (1.0 - cover_v) * face;
         break;
       }
     }

@@ -69,13 +69,6 @@ inline double ValueNoise(double x, double y, uint32_t seed) {
   return (v00 + sx * (v10 - v00)) + sy * ((v01 + sx * (v11 - v01)) - (v00 + sx * (v10 - v00)));
 }
 
-// Three octaves of value noise, in [0, 1].
-inline double FractalNoise(double x, double y, uint32_t seed) {
-  return (ValueNoise(x, y, seed) * 4.0 + ValueNoise(2.03 * x, 2.03 * y, seed + 1) * 2.0 +
-          ValueNoise(4.07 * x, 4.07 * y, seed + 2)) /
-         7.0;
-}
-
 }  // namespace pldvo::synthetic::internal
 
 #endif  // PLDVO_CORE_SYNTHETIC_SYNTHETIC_INTERNAL_H_

@@ -214,6 +214,9 @@ std::string SynthOptions::Check() const {
   if (!(fps > 0.0)) return "fps: must be > 0";
   if (!(noise_sigma >= 0.0)) return "noise_sigma: must be >= 0";
   if (supersampling < 1 || supersampling > 16) return "supersampling: must be in [1, 16]";
+  if (!(texture_filter_sigma_px >= 0.0 && texture_filter_sigma_px <= 4.0)) {
+    return "texture_filter_sigma_px: must be in [0, 4]";
+  }
   if (motion_blur_samples < 1 || motion_blur_samples > 64) {
     return "motion_blur_samples: must be in [1, 64]";
   }

@@ -38,8 +38,9 @@ struct SynthOptions {
   double cx = -1.0;  // < 0: (width - 1) / 2
   double cy = -1.0;  // < 0: (height - 1) / 2
   double fps = 30.0;
-  double noise_sigma = 1.0;  // gray levels, Gaussian, i.i.d. per pixel
-  int supersampling = 4;     // n x n samples at pixels on a surface boundary; 1 = off
+  double noise_sigma = 1.0;              // gray levels, Gaussian, i.i.d. per pixel
+  int supersampling = 4;                 // n x n samples at pixels on a surface boundary; 1 = off
+  double texture_filter_sigma_px = 0.0;  // Gaussian pixel response on textures; 0 = point samples
   bool motion_blur = false;
   int motion_blur_samples = 5;  // sub-frame poses averaged when motion_blur
   double exposure = 0.5;        // exposure time as a fraction of the frame interval
@@ -74,6 +75,9 @@ struct SynthOptions {
     v.Field("noise_sigma", &noise_sigma, "Gaussian sensor noise, gray levels (0 = off).");
     v.Field("supersampling", &supersampling,
             "n x n samples per pixel on surface boundaries (anti-aliasing); 1 = off.");
+    v.Field("texture_filter_sigma_px", &texture_filter_sigma_px,
+            "Std. dev. in pixels of the Gaussian pixel response that band-limits the textures "
+            "(0 = point samples, which alias fine patterns at grazing angles).");
     v.Field("motion_blur", &motion_blur, "Average sub-frame renderings over the exposure.");
     v.Field("motion_blur_samples", &motion_blur_samples, "Sub-frames per motion-blurred frame.");
     v.Field("exposure", &exposure, "Exposure as a fraction of the frame interval (motion blur).");
@@ -137,6 +141,23 @@ struct Primitive {
   std::string name;  // "wall", "cabinet", "table_top", ... (for docs and debugging)
 };
 
+// What a pixel integrates at a ray's hit: the hit point's derivatives with respect to the image
+// x and y (world frame, metres per pixel) and the standard deviation of the pixel's Gaussian
+// response in pixels (0: the pixel samples the surface at one point).
+struct PixelFootprint {
+  Eigen::Vector3d point_per_x = Eigen::Vector3d::Zero();
+  Eigen::Vector3d point_per_y = Eigen::Vector3d::Zero();
+  double sigma_px = 0.0;
+
+  // Ray differentials (Igehy 1999) on the hit's plane n . (p - p_hit) = 0, for the ray
+  // origin + t direction whose direction changes by ray_per_x, ray_per_y per pixel: a direction
+  // d + e meets the plane at p_hit + t (e - d (n . e) / (n . d)) to first order. A ray along the
+  // plane gets a footprint so wide that the pattern takes its mean.
+  static PixelFootprint OnPlane(const Eigen::Vector3d& normal, const Eigen::Vector3d& direction,
+                                double t, const Eigen::Vector3d& ray_per_x,
+                                const Eigen::Vector3d& ray_per_y, double sigma_px);
+};
+
 class Scene {
  public:
   Scene() = default;
@@ -168,9 +189,11 @@ class Scene {
                        const int* indices, int count, Hit* hit) const;
   // Albedo at a hit point: the face's albedo times its procedural pattern
   // (1 + texture_contrast (2 w - 1), w in [0, 1]) and a smooth variation
-  // (1 + albedo_variation (2 n - 1), n value noise of 1 m cells).
+  // (1 + albedo_variation (2 n - 1), n value noise of 1 m cells). With a footprint of
+  // sigma_px > 0 the pattern is band-limited by the pixel's response (docs/synthetic.md,
+  // "Texture filtering"): sinusoidal bands exactly, value noise and grout approximately.
   double Albedo(const Hit& hit, const Eigen::Vector3d& point_in_world, double texture_contrast,
-                double albedo_variation) const;
+                double albedo_variation, const PixelFootprint& footprint) const;
   // Distance from a point to the nearest surface (room walls and boxes).
   double DistanceToSurfaces(const Eigen::Vector3d& point_in_world) const;
 
