@@ -490,15 +490,27 @@ TEST(TrackerTest, CallbackRecordsEdgePixelsThatEndOnTheirLines) {
 }
 
 TEST(TrackerTest, LostOnAnUnrelatedImage) {
+  // Uniform noise and two views of other parts of the room from the current frame's position
+  // (looking backwards and sideways). Measured inlier fractions 0.332, 0.240, 0.213 against the
+  // 0.5 threshold (0.96 for the true frame). The criterion's known weakness, the current frame
+  // turned by 180 degrees at 0.500 and noise draws up to 0.51 on filtered textures, is in
+  // docs/tracking.md ("Lost detection against unrelated images").
   const FramePair& pair = Pair("textured");
   const TrackingReference reference =
       MakePairReference(pair, GroundTruthReferenceOptions(), /*with_edges=*/false);
-  cv::Mat unrelated(pair.cur_image.size(), CV_8U);
-  cv::randu(unrelated, 0, 255);  // cv's default RNG state: deterministic
-  const TrackingResult result =
-      Tracker(ModeOptions(Mode::kPhotometric, SolverOptions::Type::kGaussNewton))
-          .Track(reference, ImagePyramid(unrelated, 4), SE3());
-  EXPECT_EQ(result.status, TrackingStatus::kLost) << result.inlier_fraction;
+  cv::Mat noise(pair.cur_image.size(), CV_8U);
+  cv::randu(noise, 0, 255);  // cv's default RNG state: deterministic
+  const synthetic::SyntheticSequence sequence = MakeScaledSequence("textured", 20);
+  const SE3& world_from_cur = sequence.ground_truth[14].world_from_cam;
+  const auto turned_view = [&](double yaw) {
+    const SE3 turned = world_from_cur * SE3::Exp((Vector6d() << 0, 0, 0, 0, yaw, 0).finished());
+    return synthetic::RenderView(sequence, turned).image;
+  };
+  const Tracker tracker(ModeOptions(Mode::kPhotometric, SolverOptions::Type::kGaussNewton));
+  for (const cv::Mat& image : {noise, turned_view(M_PI), turned_view(M_PI / 2)}) {
+    const TrackingResult result = tracker.Track(reference, ImagePyramid(image, 4), SE3());
+    EXPECT_EQ(result.status, TrackingStatus::kLost) << result.inlier_fraction;
+  }
 }
 
 TEST(TrackerTest, RejectsInvalidOptions) {
