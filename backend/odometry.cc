@@ -508,7 +508,9 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, PreparedFrame
       return result;
     }
     result.message = "tracking lost (valid residuals " + std::to_string(tracking.valid_residuals) +
-                     ", inlier fraction " + std::to_string(tracking.inlier_fraction) + ")";
+                     ", inlier fraction " + std::to_string(tracking.inlier_fraction) +
+                     ", intensity correlation " + std::to_string(tracking.intensity_correlation) +
+                     ")";
   } else {
     result.message = "keyframe map has no points";
   }

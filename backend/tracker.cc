@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 
 #include "core/wall_clock.h"
@@ -30,6 +31,18 @@ std::vector<Eigen::Vector2d> ReprojectEdgePixels(const TrackingReferenceLevel& r
   return pixels;
 }
 
+// Pearson's correlation of the pairs (I_cur, I_ref); 0 for fewer than 2 or constant intensities.
+double IntensityCorrelation(const std::vector<Eigen::Vector2d>& cur_ref) {
+  if (cur_ref.size() < 2) return 0.0;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& p : cur_ref) mean += p;
+  mean /= static_cast<double>(cur_ref.size());
+  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+  for (const Eigen::Vector2d& p : cur_ref) scatter += (p - mean) * (p - mean).transpose();
+  const double denominator = std::sqrt(scatter(0, 0) * scatter(1, 1));
+  return denominator > 0.0 ? scatter(0, 1) / denominator : 0.0;
+}
+
 }  // namespace
 
 std::string TrackingOptions::Check() const {
@@ -47,6 +60,9 @@ std::string TrackingOptions::Check() const {
   if (!(inlier_threshold > 0.0)) return "inlier_threshold must be > 0";
   if (!(min_inlier_fraction >= 0.0 && min_inlier_fraction <= 1.0)) {
     return "min_inlier_fraction must be in [0, 1]";
+  }
+  if (!(min_intensity_correlation >= -1.0 && min_intensity_correlation <= 1.0)) {
+    return "min_intensity_correlation must be in [-1, 1]";
   }
   return "";
 }
@@ -73,6 +89,9 @@ ResidualStatistics EvaluateResidualStatistics(const LeastSquaresProblem& problem
                                               double inlier_threshold) {
   ResidualStatistics stats;
   std::vector<double> residuals(problem.MaxBlockResiduals());
+  std::vector<double> errors(residuals.size());
+  std::vector<std::uint8_t> error_valid(residuals.size());
+  std::vector<Eigen::Vector2d> cur_ref;  // (I_cur, I_ref) of the valid photometric rows
   for (const LeastSquaresProblem::ResidualBlock& block : problem.residual_blocks()) {
     const int rows = block.cost_function->num_residuals();
     if (!block.cost_function->Evaluate(block.parameters.data(), residuals.data(), nullptr)) {
@@ -91,7 +110,15 @@ ResidualStatistics EvaluateResidualStatistics(const LeastSquaresProblem& problem
     // valid(i) reflects the Evaluate above.
     const auto* photometric = dynamic_cast<const PhotometricResidual*>(block.cost_function);
     const auto* line = dynamic_cast<const PointToLineResidual*>(block.cost_function);
-    if (photometric != nullptr) stats.photometric_cost += block_cost;
+    if (photometric != nullptr) {
+      stats.photometric_cost += block_cost;
+      photometric->IntensityErrors(PoseFromParameters(block.parameters[0]), errors.data(),
+                                   error_valid.data());
+      for (int i = 0; i < rows; ++i) {
+        const double intensity_ref = photometric->observations()[i].intensity_ref;
+        if (error_valid[i]) cur_ref.emplace_back(intensity_ref - errors[i], intensity_ref);
+      }
+    }
     for (int i = 0; i < rows; ++i) {
       const bool valid = photometric != nullptr ? photometric->valid(i)
                          : line != nullptr      ? line->valid(i)
@@ -108,6 +135,7 @@ ResidualStatistics EvaluateResidualStatistics(const LeastSquaresProblem& problem
       if (magnitude <= inlier_threshold) ++stats.inlier_rows;
     }
   }
+  stats.intensity_correlation = IntensityCorrelation(cur_ref);
   return stats;
 }
 
@@ -172,6 +200,8 @@ TrackingResult Tracker::Track(const TrackingReference& reference, const ImagePyr
     level_result.final_cost = final_stats.cost;
     level_result.valid_rows = final_stats.valid_rows;
     level_result.inlier_rows = final_stats.inlier_rows;
+    level_result.photometric_valid_rows = final_stats.photometric_valid_rows;
+    level_result.intensity_correlation = final_stats.intensity_correlation;
     level_result.rms = final_stats.valid_rows > 0
                            ? std::sqrt(2.0 * final_stats.cost / final_stats.valid_rows)
                            : 0.0;
@@ -189,9 +219,12 @@ TrackingResult Tracker::Track(const TrackingReference& reference, const ImagePyr
   result.final_photometric_rms = finest.photometric_rms;
   result.inlier_fraction =
       finest.valid_rows > 0 ? static_cast<double>(finest.inlier_rows) / finest.valid_rows : 0.0;
+  result.intensity_correlation = finest.intensity_correlation;
   const bool lost = finest.valid_rows < std::max(1, options_.min_valid_residuals) ||
                     finest.valid_rows < options_.min_valid_fraction * finest.residual_rows ||
-                    result.inlier_fraction < options_.min_inlier_fraction;
+                    result.inlier_fraction < options_.min_inlier_fraction ||
+                    (finest.photometric_valid_rows > 0 &&
+                     result.intensity_correlation < options_.min_intensity_correlation);
   if (lost) {
     result.status = TrackingStatus::kLost;
   } else {

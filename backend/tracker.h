@@ -12,7 +12,12 @@
 //   kLost        fewer than min_valid_residuals valid rows, or fewer than min_valid_fraction of
 //                the rows added at the finest level still valid, or fewer than
 //                min_inlier_fraction of the valid rows inliers (|r~| <= inlier_threshold, r~ the
-//                whitened, robustified residual: the LSD-SLAM "good pixel" ratio);
+//                whitened, robustified residual: the LSD-SLAM "good pixel" ratio), or, when
+//                the finest level has photometric rows, a correlation of I_ref and I_cur over
+//                them below min_intensity_correlation (docs/tracking.md, "Lost detection
+//                against unrelated images": the whitened fraction passes noise images, whose
+//                run-away translation inflates the depth term of Sigma_r; the correlation,
+//                free of Sigma_r, of gain and of bias, does not);
 //   kConverged   otherwise, when the finest level's solver stopped on a tolerance;
 //   kNotConverged otherwise (iteration limit at the finest level).
 #ifndef PLDVO_BACKEND_TRACKER_H_
@@ -47,6 +52,7 @@ struct TrackingOptions {
   double min_valid_fraction = 0.3;
   double inlier_threshold = 2.0;  // whitened units: 2 sigma of the residual model
   double min_inlier_fraction = 0.5;
+  double min_intensity_correlation = 0.3;
   // Compute the reprojected edge pixels for the iteration callback (the paper's Fig. 2).
   bool record_edge_pixels = true;
 
@@ -66,6 +72,9 @@ struct TrackingOptions {
             "A valid row is an inlier when its whitened robustified residual is below this.");
     v.Field("min_inlier_fraction", &min_inlier_fraction,
             "Lost when fewer than this fraction of the valid rows are inliers.");
+    v.Field("min_intensity_correlation", &min_intensity_correlation,
+            "Lost when the correlation of I_ref and I_cur over the valid photometric rows is "
+            "below this (0.3; -1: off).");
     v.Field("record_edge_pixels", &record_edge_pixels,
             "Give the iteration callback the reprojected edge pixels (Fig. 2).");
   }
@@ -81,6 +90,8 @@ struct LevelResult {
   int residual_rows = 0;  // added by the builder
   int valid_rows = 0;     // valid at the level's final pose
   int inlier_rows = 0;    // valid with |r~| <= inlier_threshold
+  int photometric_valid_rows = 0;
+  double intensity_correlation = 0.0;  // over the valid photometric rows (0 with fewer than 2)
   double initial_cost = 0.0;
   double final_cost = 0.0;
   double rms = 0.0;              // sqrt(2 final_cost / valid_rows)
@@ -94,9 +105,10 @@ struct TrackingResult {
   SE3 initial_cur_from_ref;  // the initial guess this result was solved from
   double ms = 0.0;           // wall time of the Track call
   TrackingStatus status = TrackingStatus::kLost;
-  std::vector<LevelResult> levels;  // in the order solved (coarse to fine)
-  int valid_residuals = 0;          // at the final pose, finest level
-  double inlier_fraction = 0.0;     // inlier_rows / valid_rows at the finest level
+  std::vector<LevelResult> levels;     // in the order solved (coarse to fine)
+  int valid_residuals = 0;             // at the final pose, finest level
+  double inlier_fraction = 0.0;        // inlier_rows / valid_rows at the finest level
+  double intensity_correlation = 0.0;  // the finest level's
   double final_rms = 0.0;
   double final_photometric_rms = 0.0;  // finest level, photometric rows only (0 without any)
   int TotalIterations() const;
@@ -136,7 +148,10 @@ class Tracker {
 // Valid rows, inliers and cost of a problem at its current parameters: evaluates every block;
 // rows of PhotometricResidual / PointToLineResidual count when valid, rows of other cost
 // functions always count. A valid row is an inlier when |r~| <= inlier_threshold, with r~ the
-// row as evaluated, or sign(r) sqrt(rho(r^2)) for a block with a LossFunction.
+// row as evaluated, or sign(r) sqrt(rho(r^2)) for a block with a LossFunction. The intensity
+// correlation is Pearson's, of (I_cur, I_ref) over the valid PhotometricResidual rows
+// (PhotometricResidual::IntensityErrors gives I_cur = I_ref - e); 0 for fewer than 2 rows or
+// constant intensities.
 struct ResidualStatistics {
   int rows = 0;
   int valid_rows = 0;
@@ -144,6 +159,7 @@ struct ResidualStatistics {
   double cost = 0.0;
   // The PhotometricResidual blocks alone.
   int photometric_valid_rows = 0;
+  double intensity_correlation = 0.0;
   double photometric_cost = 0.0;
 };
 ResidualStatistics EvaluateResidualStatistics(const LeastSquaresProblem& problem,

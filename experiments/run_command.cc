@@ -199,7 +199,7 @@ int RunOdometryCommand(const CommandContext& context) {
   trajectory_file << "# pldvo run: timestamp tx ty tz qx qy qz qw (world_from_cam), dataset "
                   << FLAGS_dataset << "\n";
   timing_file << "index,timestamp,status,keyframe_id,lines,matches,line_outliers,reference_points,"
-                 "alternatives,iterations,final_rms,inlier_fraction";
+                 "alternatives,iterations,final_rms,inlier_fraction,intensity_correlation";
   for (const char* key : kTimingKeys) timing_file << "," << key << "_ms";
   timing_file << "\n";
   if (!written(trajectory_file, "trajectory.txt") || !written(timing_file, "timing.csv")) return 1;
@@ -342,7 +342,8 @@ int RunOdometryCommand(const CommandContext& context) {
                 << result.num_lines << "," << result.num_matches << "," << result.num_line_outliers
                 << "," << result.num_reference_points << "," << result.alternatives_tried << ","
                 << result.tracking.TotalIterations() << "," << std::setprecision(6)
-                << result.tracking.final_rms << "," << result.tracking.inlier_fraction;
+                << result.tracking.final_rms << "," << result.tracking.inlier_fraction << ","
+                << result.tracking.intensity_correlation;
     for (double value : Values(row)) timing_file << "," << std::setprecision(4) << value;
     timing_file << "\n";
     if (!written(timing_file, "timing.csv")) return 1;

@@ -187,6 +187,22 @@ void PhotometricResidual::EvaluateTangent(const SE3& cur_from_ref, double* resid
   });
 }
 
+void PhotometricResidual::IntensityErrors(const SE3& cur_from_ref, double* errors,
+                                          std::uint8_t* valid) const {
+  const Eigen::Matrix3d rotation = cur_from_ref.rotation_matrix();
+  const Eigen::Vector3d& translation = cur_from_ref.translation();
+  const int n = num_observations();
+  WithSampler(interpolation_, cur_pyramid_, level_, bicubic_.get(), [&](const auto& sample) {
+    for (int i = 0; i < n; ++i) {
+      PhotometricObservation unweighted = observations_[i];
+      unweighted.sqrt_info = 1.0;
+      const bool ok = PhotometricRow(sample, camera_, unweighted, rays_in_ref_[i], rotation,
+                                     translation, nullptr, errors + i, nullptr);
+      if (valid != nullptr) valid[i] = ok;
+    }
+  });
+}
+
 std::vector<Eigen::Vector2d> PhotometricResidual::ReprojectedPixels(
     const SE3& cur_from_ref, std::vector<std::uint8_t>* valid) const {
   return ReprojectRays(camera_, rays_in_ref_, observations_, cur_from_ref, valid,

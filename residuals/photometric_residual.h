@@ -107,6 +107,11 @@ class PhotometricResidual : public ceres::CostFunction {
   void EvaluateTangent(const SE3& cur_from_ref, double* residuals, double* jacobian_tangent,
                        std::uint8_t* valid) const;
 
+  // The unweighted intensity errors e_i = I_ref(x_i) - I_cur(tau(x_i, d_i, xi)) for a pose: the
+  // rows without sqrt_info and without the robust loss (the image-noise inlier test of the
+  // tracker), with validity as in Evaluate (e_i = 0 where invalid). No heap allocation.
+  void IntensityErrors(const SE3& cur_from_ref, double* errors, std::uint8_t* valid) const;
+
   // The reprojected pixels tau(x_i, d_i, xi) for a pose (the paper's Fig. 2 iteration images),
   // with their validity (same rule as in Evaluate); NaN behind the camera. Allocates; not for
   // hot loops.

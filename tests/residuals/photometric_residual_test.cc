@@ -327,6 +327,26 @@ TEST_F(PhotometricResidualTest, RobustRowsSumToRobustCost) {
   }
 }
 
+// IntensityErrors are the rows without weight and loss: I_ref - I_cur, whatever the loss.
+TEST_F(PhotometricResidualTest, IntensityErrorsAreTheUnweightedRows) {
+  const auto observations = MakeObservations(smooth_, 50, Placement::kRandom, 7);
+  const int n = static_cast<int>(observations.size());
+  const auto loss = MakeLoss(Loss::kHuber);
+  for (const ImageInterpolation interpolation : kInterpolations) {
+    const PhotometricResidual plain(smooth_, 0, camera_, observations, nullptr, interpolation);
+    const PhotometricResidual robust(smooth_, 0, camera_, observations, loss.get(), interpolation);
+    Eigen::VectorXd r_plain(n), errors(n);
+    std::vector<std::uint8_t> valid(n, 0);
+    const double* parameters[] = {pose_};
+    plain.Evaluate(parameters, r_plain.data(), nullptr);
+    robust.IntensityErrors(cur_from_ref_, errors.data(), valid.data());
+    for (int i = 0; i < n; ++i) {
+      ASSERT_TRUE(valid[i]);
+      EXPECT_NEAR(errors[i] * observations[i].sqrt_info, r_plain[i], 1e-9) << i;
+    }
+  }
+}
+
 TEST_F(PhotometricResidualTest, BatchRowsEqualPerPixelForm) {
   for (const ImageInterpolation interpolation : kInterpolations) {
     const auto observations = MakeObservations(smooth_, 10, Placement::kRandom, 6);
@@ -394,6 +414,13 @@ TEST_F(PhotometricResidualTest, InvalidRowsAreZeroAndFlagged) {
     cost.EvaluateTangent(cur_from_ref, tangent_residuals, nullptr, tangent_valid);
     EXPECT_EQ(tangent_valid[0], 1);
     EXPECT_EQ(tangent_valid[2], 0);
+    std::uint8_t error_valid[4];
+    double errors[4];
+    cost.IntensityErrors(cur_from_ref, errors, error_valid);
+    EXPECT_EQ(std::vector<std::uint8_t>(error_valid, error_valid + 4),
+              (std::vector<std::uint8_t>{1, 0, 0, 0}));
+    EXPECT_EQ(errors[0], residuals[0]);  // sqrt_info 1, no loss
+    EXPECT_EQ(errors[2], 0.0);
   }
 }
 
