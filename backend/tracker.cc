@@ -86,11 +86,13 @@ int TrackingResult::TotalIterations() const {
 }
 
 ResidualStatistics EvaluateResidualStatistics(const LeastSquaresProblem& problem,
-                                              double inlier_threshold) {
+                                              double inlier_threshold,
+                                              bool with_intensity_correlation) {
   ResidualStatistics stats;
   std::vector<double> residuals(problem.MaxBlockResiduals());
-  std::vector<double> errors(residuals.size());
-  std::vector<std::uint8_t> error_valid(residuals.size());
+  const size_t error_rows = with_intensity_correlation ? residuals.size() : 0;
+  std::vector<double> errors(error_rows);
+  std::vector<std::uint8_t> error_valid(error_rows);
   std::vector<Eigen::Vector2d> cur_ref;  // (I_cur, I_ref) of the valid photometric rows
   for (const LeastSquaresProblem::ResidualBlock& block : problem.residual_blocks()) {
     const int rows = block.cost_function->num_residuals();
@@ -110,8 +112,8 @@ ResidualStatistics EvaluateResidualStatistics(const LeastSquaresProblem& problem
     // valid(i) reflects the Evaluate above.
     const auto* photometric = dynamic_cast<const PhotometricResidual*>(block.cost_function);
     const auto* line = dynamic_cast<const PointToLineResidual*>(block.cost_function);
-    if (photometric != nullptr) {
-      stats.photometric_cost += block_cost;
+    if (photometric != nullptr) stats.photometric_cost += block_cost;
+    if (photometric != nullptr && with_intensity_correlation) {
       photometric->IntensityErrors(PoseFromParameters(block.parameters[0]), errors.data(),
                                    error_valid.data());
       for (int i = 0; i < rows; ++i) {
@@ -196,7 +198,8 @@ TrackingResult Tracker::Track(const TrackingReference& reference, const ImagePyr
     level_result.converged = summary.converged;
     level_result.solver_message = summary.message;
     const ResidualStatistics final_stats =
-        EvaluateResidualStatistics(problem, options_.inlier_threshold);
+        EvaluateResidualStatistics(problem, options_.inlier_threshold,
+                                   /*with_intensity_correlation=*/level == options_.finest_level);
     level_result.final_cost = final_stats.cost;
     level_result.valid_rows = final_stats.valid_rows;
     level_result.inlier_rows = final_stats.inlier_rows;

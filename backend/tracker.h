@@ -91,7 +91,8 @@ struct LevelResult {
   int valid_rows = 0;     // valid at the level's final pose
   int inlier_rows = 0;    // valid with |r~| <= inlier_threshold
   int photometric_valid_rows = 0;
-  double intensity_correlation = 0.0;  // over the valid photometric rows (0 with fewer than 2)
+  // Over the valid photometric rows (0 with fewer than 2); computed at the finest level only.
+  double intensity_correlation = 0.0;
   double initial_cost = 0.0;
   double final_cost = 0.0;
   double rms = 0.0;              // sqrt(2 final_cost / valid_rows)
@@ -150,8 +151,8 @@ class Tracker {
 // functions always count. A valid row is an inlier when |r~| <= inlier_threshold, with r~ the
 // row as evaluated, or sign(r) sqrt(rho(r^2)) for a block with a LossFunction. The intensity
 // correlation is Pearson's, of (I_cur, I_ref) over the valid PhotometricResidual rows
-// (PhotometricResidual::IntensityErrors gives I_cur = I_ref - e); 0 for fewer than 2 rows or
-// constant intensities.
+// (PhotometricResidual::IntensityErrors gives I_cur = I_ref - e), computed only when
+// `with_intensity_correlation`; 0 for fewer than 2 rows or constant intensities.
 struct ResidualStatistics {
   int rows = 0;
   int valid_rows = 0;
@@ -163,7 +164,8 @@ struct ResidualStatistics {
   double photometric_cost = 0.0;
 };
 ResidualStatistics EvaluateResidualStatistics(const LeastSquaresProblem& problem,
-                                              double inlier_threshold);
+                                              double inlier_threshold,
+                                              bool with_intensity_correlation);
 
 }  // namespace pldvo
 

@@ -108,8 +108,8 @@ class PhotometricResidual : public ceres::CostFunction {
                        std::uint8_t* valid) const;
 
   // The unweighted intensity errors e_i = I_ref(x_i) - I_cur(tau(x_i, d_i, xi)) for a pose: the
-  // rows without sqrt_info and without the robust loss (the image-noise inlier test of the
-  // tracker), with validity as in Evaluate (e_i = 0 where invalid). No heap allocation.
+  // rows without sqrt_info and without the robust loss (the tracker's intensity correlation),
+  // with validity as in Evaluate (e_i = 0 where invalid). No heap allocation.
   void IntensityErrors(const SE3& cur_from_ref, double* errors, std::uint8_t* valid) const;
 
   // The reprojected pixels tau(x_i, d_i, xi) for a pose (the paper's Fig. 2 iteration images),
