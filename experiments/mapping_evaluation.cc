@@ -168,14 +168,15 @@ std::string MapEvalConfig::Check() const {
   return "";
 }
 
-MapEvalResult RunMapEvaluation(const MapEvalConfig& config) {
+MapEvalResult RunMapEvaluation(const MapEvalConfig& config,
+                               const RenderFrameFunction& render_frame) {
   const std::string error = config.Check();
   if (!error.empty()) throw std::invalid_argument("MapEvalConfig: " + error);
   synthetic::SynthOptions synth = config.synth;
   synth.frames = config.keyframe_index + config.num_frames * config.frame_stride + 1;
   const synthetic::SyntheticSequence sequence = synthetic::MakeSequence(synth);
   auto render = [&](int index) {
-    const synthetic::RenderedFrame rendered = synthetic::RenderFrame(sequence, index);
+    const synthetic::RenderedFrame rendered = render_frame(sequence, index);
     return Frame{rendered.image, rendered.depth, sequence.ground_truth[index].world_from_cam};
   };
   const Frame keyframe = render(config.keyframe_index);

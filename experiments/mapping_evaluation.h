@@ -8,6 +8,7 @@
 #ifndef PLDVO_EXPERIMENTS_MAPPING_EVALUATION_H_
 #define PLDVO_EXPERIMENTS_MAPPING_EVALUATION_H_
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -110,8 +111,14 @@ struct MapEvalResult {
   int propagated_count = 0;
 };
 
+// Renders frame `index` of a sequence: synthetic::RenderFrame, or the tests' render cache
+// (tests/render_cache.h), which renders a sequence once for all the evaluations of a test run.
+using RenderFrameFunction =
+    std::function<synthetic::RenderedFrame(const synthetic::SyntheticSequence&, int)>;
+
 // Throws std::invalid_argument on an invalid config.
-MapEvalResult RunMapEvaluation(const MapEvalConfig& config);
+MapEvalResult RunMapEvaluation(const MapEvalConfig& config,
+                               const RenderFrameFunction& render_frame = synthetic::RenderFrame);
 std::string FormatMapEvalTable(const MapEvalResult& result);
 
 }  // namespace pldvo

@@ -17,7 +17,7 @@ cmake -S . -B "$build" -G Ninja \
   -DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link" \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
   -DPLDVO_SANITIZE=ON -DPLDVO_BUILD_FUZZERS=ON \
-  -DPLDVO_BUILD_TESTS=OFF -DPLDVO_BUILD_BENCHMARKS=OFF >/dev/null
+  -DPLDVO_BUILD_TESTS=OFF -DPLDVO_BUILD_BENCHMARKS=OFF -DPLDVO_PRECOMPILE_HEADERS=ON >/dev/null
 cmake --build "$build" -j "$(nproc)" --target pldvo_fuzzers
 
 targets=("$@")

@@ -3,8 +3,10 @@
 // vs photometric stereo on edge pixels, the 3D line regularisation, NEES and propagation.
 // Measured values at this config (pldvo mapeval with the same --set keys) are quoted next to each
 // tolerance; the tolerances leave ~2x margin on them and sit far from what a broken stage gives
-// (the random initialisation has a median relative error of ~60%). The TESTs reading Result()
-// share one evaluation: ctest runs this binary as one process (ONE_PROCESS, tests/CMakeLists.txt).
+// (the random initialisation has a median relative error of ~60%). The TESTs reading Result() or
+// TexturedSeed2Result() share one evaluation: ctest runs this binary as one process (ONE_PROCESS,
+// tests/CMakeLists.txt), and the evaluations of one sequence render its frames once (the render
+// cache).
 #include <gtest/gtest.h>
 
 #include <stdexcept>
@@ -12,6 +14,7 @@
 #include <utility>
 
 #include "experiments/mapping_evaluation.h"
+#include "tests/render_cache.h"
 
 namespace pldvo {
 namespace {
@@ -42,8 +45,18 @@ MapEvalConfig SequenceConfig(const std::string& preset, int seed) {
   return config;
 }
 
+MapEvalResult Evaluate(const MapEvalConfig& config) {
+  return RunMapEvaluation(config, test::RenderFrameForTest);
+}
+
 const MapEvalResult& Result() {
-  static const MapEvalResult result = RunMapEvaluation(SmallConfig());
+  static const MapEvalResult result = Evaluate(SmallConfig());
+  return result;
+}
+
+// The default config on textured seed 2, the reference of two TESTs.
+const MapEvalResult& TexturedSeed2Result() {
+  static const MapEvalResult result = Evaluate(SequenceConfig("textured", 2));
   return result;
 }
 
@@ -85,9 +98,9 @@ TEST(DepthMapperTest, SsdRefinementRescuesLineGuidedStereoFromNoisyLines) {
   MapEvalConfig config = SmallConfig();
   config.line_sigma_px = 1.0;
   config.line_sigma_sweep = {};
-  const MapEvalResult plain = RunMapEvaluation(config);
+  const MapEvalResult plain = Evaluate(config);
   config.mapping.line_stereo_refine_ssd = true;
-  const MapEvalResult refined = RunMapEvaluation(config);
+  const MapEvalResult refined = Evaluate(config);
   const double plain_error = plain.line_guided.edges_line_regularized.median_rel_error;
   const double refined_error = refined.line_guided.edges_line_regularized.median_rel_error;
   const double photometric_error = refined.photometric.edges_line_regularized.median_rel_error;
@@ -144,9 +157,9 @@ TEST(DepthMapperTest, CorrelatedFusionReducesGrossErrorsOnLowTexture) {
   // pixels are mostly wrong matches (docs/mapping.md), which no variance model makes consistent.
   MapEvalConfig config = SequenceConfig("lowtex", 2);
   ASSERT_GT(config.mapping.stereo_error_correlation, 0.0);  // the default is the new model
-  const MapEvalResult correlated = RunMapEvaluation(config);
+  const MapEvalResult correlated = Evaluate(config);
   config.mapping.stereo_error_correlation = 0.0;
-  const MapEvalResult independent = RunMapEvaluation(config);
+  const MapEvalResult independent = Evaluate(config);
   const std::pair<const MapEvalRun*, const MapEvalRun*> runs[] = {
       {&correlated.photometric, &independent.photometric},
       {&correlated.line_guided, &independent.line_guided}};
@@ -190,10 +203,10 @@ TEST(DepthMapperTest, HalfPixelStepsAndAmbiguityVarianceShrinkTheTextureTail) {
   MapEvalConfig config = SequenceConfig("textured", 2);
   ASSERT_EQ(config.mapping.ssd_search_step_px, 0.5);
   ASSERT_TRUE(config.mapping.ssd_ambiguity_variance);
-  const MapEvalResult half = RunMapEvaluation(config);
+  const MapEvalResult& half = TexturedSeed2Result();
   config.mapping.ssd_search_step_px = 1.0;
   config.mapping.ssd_ambiguity_variance = false;
-  const MapEvalResult one = RunMapEvaluation(config);
+  const MapEvalResult one = Evaluate(config);
   ExpectShrunkenTail(half, one, /*nees_factor=*/0.5, /*gross_factor=*/0.7,
                      /*rel_error_factor=*/1.02);
 }
@@ -208,9 +221,9 @@ TEST(DepthMapperTest, InlierRatioFilterShrinksTheTextureTail) {
   // (2% slack).
   MapEvalConfig config = SequenceConfig("textured", 2);
   ASSERT_EQ(config.mapping.outlier_model, MappingOptions::OutlierModel::kValidityCounter);
-  const MapEvalResult counter = RunMapEvaluation(config);
+  const MapEvalResult& counter = TexturedSeed2Result();
   config.mapping.outlier_model = MappingOptions::OutlierModel::kInlierRatio;
-  const MapEvalResult ratio = RunMapEvaluation(config);
+  const MapEvalResult ratio = Evaluate(config);
   ExpectShrunkenTail(ratio, counter, /*nees_factor=*/0.75, /*gross_factor=*/0.95,
                      /*rel_error_factor=*/1.02);
 }
@@ -226,9 +239,9 @@ TEST(DepthMapperTest, KeyframeLineVarianceKeepsNoisyEdgesConsistent) {
   config.line_sigma_px = 0.5;
   config.keyframe_line_sigma_px = 0.5;
   ASSERT_TRUE(config.mapping.line_stereo_keyframe_line_var);
-  const MapEvalResult with = RunMapEvaluation(config);
+  const MapEvalResult with = Evaluate(config);
   config.mapping.line_stereo_keyframe_line_var = false;
-  const MapEvalResult without = RunMapEvaluation(config);
+  const MapEvalResult without = Evaluate(config);
   const DepthErrorStats& a = with.line_guided.edges;
   const DepthErrorStats& b = without.line_guided.edges;
   ASSERT_GT(a.count, 3000);
@@ -246,7 +259,7 @@ TEST(DepthMapperTest, FrontendLinesGuideTheStereoOnLowTexture) {
   // line-guided 0.0053; line-guided continuous mean NEES 0.78, edge gross fraction 0.46%.
   MapEvalConfig config = SequenceConfig("lowtex", 2);
   config.frontend_lines = true;
-  const MapEvalResult r = RunMapEvaluation(config);
+  const MapEvalResult r = Evaluate(config);
   EXPECT_TRUE(r.frontend_lines);
   EXPECT_GT(r.num_edges, 20);
   ASSERT_GT(r.line_guided.edges.count, 500);
@@ -256,10 +269,10 @@ TEST(DepthMapperTest, FrontendLinesGuideTheStereoOnLowTexture) {
   EXPECT_LT(r.line_guided.edges.gross_fraction, 0.02);
   // The sweep and the keyframe line noise perturb GT lines, which this mode does not have.
   config.keyframe_line_sigma_px = 0.5;
-  EXPECT_THROW(RunMapEvaluation(config), std::invalid_argument);
+  EXPECT_THROW(Evaluate(config), std::invalid_argument);
   config.keyframe_line_sigma_px = 0.0;
   config.line_sigma_sweep = {0.5};
-  EXPECT_THROW(RunMapEvaluation(config), std::invalid_argument);
+  EXPECT_THROW(Evaluate(config), std::invalid_argument);
 }
 
 TEST(DepthMapperTest, PropagationKeepsAccuracy) {

@@ -309,8 +309,7 @@ TEST(OdometryConfigTest, UnknownKeyIsAnError) {
 
 TEST(OdometryConfigTest, ShippedConfigsLoadAndTakeTheSolverSwitch) {
   const std::filesystem::path dir =
-      std::filesystem::path(PLDVO_TEST_DATA_DIR).parent_path().parent_path().parent_path() /
-      "experiments" / "configs";
+      std::filesystem::path(PLDVO_SOURCE_DIR) / "experiments" / "configs";
   for (const char* name :
        {"sdvo", "points_lines", "lines_only", "uniform_weights", "fixed_ratio"}) {
     OdometryConfig config;
