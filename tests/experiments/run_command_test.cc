@@ -403,6 +403,10 @@ TEST(AblateCommandTest, TinyGridWritesTablesAndPlot) {
   EXPECT_NE(md.find("| sequence | sdvo | points_lines |"), std::string::npos) << md;
   EXPECT_NE(md.find("| lowtex |"), std::string::npos) << md;
   EXPECT_NE(md.find("### Scale drift"), std::string::npos) << md;
+  // Inline mapping runs on the tracking thread, and the timing table says so.
+  EXPECT_NE(md.find("### Median tracking-thread time per frame (ms; mapping inline, included)"),
+            std::string::npos)
+      << md;
   // The trajectory plot: an SVG with the ground truth and one polyline per config.
   const std::string svg = Slurp(out / "trajectories_lowtex.svg");
   EXPECT_EQ(svg.rfind("<svg", 0), 0u);
@@ -419,6 +423,9 @@ TEST(AblateCommandTest, TinyGridWritesTablesAndPlot) {
                   TestRoot() / "ablate_missing.log"),
             1);
   EXPECT_NE(Slurp(out2 / "results.md").find("| no_such_dataset | X |"), std::string::npos)
+      << Slurp(out2 / "results.md");
+  EXPECT_NE(Slurp(out2 / "results.md").find("### Median tracking-thread time per frame (ms)\n"),
+            std::string::npos)
       << Slurp(out2 / "results.md");
 }
 
