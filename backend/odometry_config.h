@@ -2,7 +2,7 @@
 // pattern (core/options.h), so that one YAML file (experiments/configs/*.yaml), `--set key=value`
 // overrides, the effective config.yaml of a run and the key table of docs/configuration.md all
 // come from the same fields. Sections:
-//   dataset    DatasetOptions (format, camera, ground_truth)
+//   dataset    DatasetOptions (format, camera, ground_truth, normalize_exposure)
 //   lines      LineFrontendOptions (detection, merging, LBD, matching, edge tracing)
 //   tracking   TrackingOptions (solver, problem builder + weighting policy, levels, loss of track)
 //   mapping    MappingOptions (semi-dense depth filter, line-guided stereo, propagation)
@@ -273,7 +273,7 @@ struct OdometryConfig {
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
-    v.Section("dataset", &dataset, "Dataset reading (format, camera, ground truth).");
+    v.Section("dataset", &dataset, "Dataset reading (format, camera, ground truth, exposure).");
     v.Section("lines", &lines, "Line frontend: detection, merging, LBD, matching, tracing.");
     v.Section("tracking", &tracking, "Coarse-to-fine direct tracking against the keyframe.");
     v.Section("mapping", &mapping, "Semi-dense keyframe depth filter with line-guided stereo.");

@@ -44,6 +44,10 @@ struct DatasetOptions {
   // A ground-truth file overriding the one found with the dataset: KITTI poses (12 numbers a
   // line, one line per frame) for kitti, TUM format (world_from_cam) for the other formats.
   std::string ground_truth = "";
+  // tum_mono with a response calibration (pcalib.txt) and exposure times: each image is scaled by
+  // t_ref / t_i (t_ref the median exposure of the sequence), so that frames of one scene have
+  // one brightness whatever the auto-exposure did (DSO's model I = t B).
+  bool normalize_exposure = true;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
@@ -56,6 +60,10 @@ struct DatasetOptions {
     v.Field("ground_truth", &ground_truth,
             "Ground-truth file overriding the dataset's (KITTI poses for kitti, TUM format "
             "otherwise); empty uses the dataset's own.");
+    v.Field("normalize_exposure", &normalize_exposure,
+            "tum_mono with pcalib.txt and exposure times in times.txt: scale each image by the "
+            "median exposure over its own (irradiance on one scale for every frame); false keeps "
+            "G^-1(I) / V.");
   }
   // "" when valid, otherwise what is wrong.
   std::string Check() const;

@@ -355,6 +355,19 @@ std::vector<float> ReadInverseResponse(const std::string& path) {
   return inverse_response;
 }
 
+// The median of the positive exposure times (the upper median for an even count); 0 when none
+// is positive (times.txt without exposures).
+double MedianPositive(const std::vector<double>& exposures_ms) {
+  std::vector<double> positive;
+  for (const double t : exposures_ms) {
+    if (t > 0.0) positive.push_back(t);
+  }
+  if (positive.empty()) return 0.0;
+  const auto middle = positive.begin() + positive.size() / 2;
+  std::nth_element(positive.begin(), middle, positive.end());
+  return *middle;
+}
+
 // vignette.png (8 or 16 bit), normalised by its maximum; returns 1 / max(V, kMinVignette).
 cv::Mat ReadInverseVignette(const std::string& path, int width, int height) {
   const cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
@@ -401,6 +414,10 @@ class MonoVoDataset : public Dataset {
     }
     const std::string pcalib = JoinPath(dir, "pcalib.txt");
     if (IsFile(pcalib)) inverse_response_ = ReadInverseResponse(pcalib);
+    // Exposure only scales linear intensities, i.e. after G^-1 (as DSO).
+    if (options.normalize_exposure && !inverse_response_.empty()) {
+      reference_exposure_ms_ = MedianPositive(exposures_ms_);
+    }
     const std::string vignette = JoinPath(dir, "vignette.png");
     if (IsFile(vignette))
       inverse_vignette_ = ReadInverseVignette(vignette, input_.width, input_.height);
@@ -426,8 +443,11 @@ class MonoVoDataset : public Dataset {
     frame.path = images_.name(i);
     const cv::Mat raw = images_.ReadGray8(i);
     RequireSize(raw, input_.width, input_.height, frame.path);
-    // I = G^-1(I_raw) / V, per pixel, before the geometric undistortion (V lives on the raw
-    // image).
+    // I = (t_ref / t_i) G^-1(I_raw) / V, per pixel, before the geometric undistortion (V lives
+    // on the raw image); the exposure factor is 1 without normalisation or a known exposure.
+    const float exposure_scale = reference_exposure_ms_ > 0.0 && exposures_ms_[i] > 0.0
+                                     ? static_cast<float>(reference_exposure_ms_ / exposures_ms_[i])
+                                     : 1.0f;
     cv::Mat corrected(raw.size(), CV_32F);
     for (int y = 0; y < raw.rows; ++y) {
       const unsigned char* in = raw.ptr<unsigned char>(y);
@@ -438,7 +458,7 @@ class MonoVoDataset : public Dataset {
         float value =
             inverse_response_.empty() ? static_cast<float>(in[x]) : inverse_response_[in[x]];
         if (inverse_vignette != nullptr) value *= inverse_vignette[x];
-        out[x] = value;
+        out[x] = exposure_scale * value;
       }
     }
     if (override_undistorter_ != nullptr) {
@@ -494,6 +514,7 @@ class MonoVoDataset : public Dataset {
   ImageSource images_;
   std::vector<double> timestamps_;
   std::vector<double> exposures_ms_;
+  double reference_exposure_ms_ = 0.0;  // > 0: images are scaled by it / their exposure
   std::unique_ptr<CameraModel> model_;
   std::unique_ptr<Undistorter> override_undistorter_;
   PinholeCamera input_, output_;

@@ -339,11 +339,17 @@ double WriteSequence(const SyntheticSequence& sequence, const std::string& dir) 
   fs::create_directories(fs::path(dir) / "rgb");
   fs::create_directories(fs::path(dir) / "depth");
   const std::string prefix = dir + "/";
-  std::ofstream rgb_list(prefix + "rgb.txt"), depth_list(prefix + "depth.txt");
-  if (!rgb_list || !depth_list) throw std::runtime_error("WriteSequence: cannot write in " + dir);
+  std::ofstream rgb_list(prefix + "rgb.txt"), depth_list(prefix + "depth.txt"),
+      lighting_list(prefix + "lighting.txt");
+  if (!rgb_list || !depth_list || !lighting_list) {
+    throw std::runtime_error("WriteSequence: cannot write in " + dir);
+  }
   rgb_list << "# gray images (8-bit) rendered by pldvo synth\n# timestamp filename\n";
   depth_list << "# depth images (16-bit, metres x 5000, 0 = none) rendered by pldvo synth\n"
                 "# timestamp filename\n";
+  lighting_list << "# global photometric state of each frame: I = gain * radiance + bias + noise\n"
+                   "# timestamp gain bias\n"
+                << std::setprecision(9);
   double render_seconds = 0.0;
   for (int i = 0; i < static_cast<int>(sequence.ground_truth.size()); ++i) {
     const auto start = std::chrono::steady_clock::now();
@@ -359,6 +365,8 @@ double WriteSequence(const SyntheticSequence& sequence, const std::string& dir) 
     stamp << std::fixed << std::setprecision(6) << sequence.ground_truth[i].timestamp;
     rgb_list << stamp.str() << " rgb/" << name << "\n";
     depth_list << stamp.str() << " depth/" << name << "\n";
+    const Lighting lighting = LightingAt(sequence, sequence.ground_truth[i].timestamp);
+    lighting_list << stamp.str() << " " << lighting.gain << " " << lighting.bias << "\n";
   }
   WriteTrajectoryTum(sequence.ground_truth, prefix + "groundtruth.txt");
   WriteCameraYaml(*MakeCameraModel("pinhole", sequence.camera, {}), prefix + "camera.yaml");

@@ -328,6 +328,10 @@ class MonoVoTest : public DatasetTest {
     return static_cast<float>(g / vignette);
   }
 
+  // The exposure factor t_ref / t_i of frame i: exposures 10, 11, 12, 13 ms, t_ref their upper
+  // median 12 ms.
+  static double ExposureScale(int i) { return 12.0 / (10.0 + i); }
+
   void ExpectPhotometricallyCorrected(const Dataset& dataset) const {
     ASSERT_EQ(dataset.size(), 4);
     EXPECT_EQ(dataset.format(), "tum_mono");
@@ -344,7 +348,8 @@ class MonoVoTest : public DatasetTest {
       for (int y = 0; y < kHeight; ++y) {
         for (int x = 0; x < kWidth; ++x) {
           // float arithmetic on values up to 510: relative error below 1e-6.
-          ASSERT_NEAR(frame.image.at<float>(y, x), Expected(raw.at<uint8_t>(y, x), x), 1e-3)
+          ASSERT_NEAR(frame.image.at<float>(y, x),
+                      ExposureScale(i) * Expected(raw.at<uint8_t>(y, x), x), 1e-3)
               << "frame " << i << " pixel " << x << "," << y;
         }
       }
@@ -357,6 +362,27 @@ TEST_F(MonoVoTest, FolderImagesArePhotometricallyCorrected) {
   const auto dataset = OpenDataset(Path("mono"));
   ExpectPhotometricallyCorrected(*dataset);
   EXPECT_EQ(dataset->Load(0).path, Path("mono/images/00000.png"));
+}
+
+TEST_F(MonoVoTest, ExposureIsNormalisedOnlyOnLinearIntensities) {
+  MakeMono(/*zip=*/false);
+  const cv::Mat raw = Pattern(kWidth, kHeight, 3);
+  // Switched off: G^-1(I) / V alone.
+  DatasetOptions options;
+  options.normalize_exposure = false;
+  const Frame plain = OpenDataset(Path("mono"), options)->Load(3);
+  EXPECT_NEAR(plain.image.at<float>(5, 7), Expected(raw.at<uint8_t>(5, 7), 7), 1e-3);
+  // Without pcalib.txt the intensities are not linear in the exposure: no scaling either.
+  fs::remove(Path("mono/pcalib.txt"));
+  const Frame no_response = OpenDataset(Path("mono"))->Load(3);
+  const double vignette = (60000 - 30000 * 7 / (kWidth - 1)) / 60000.0;
+  EXPECT_NEAR(no_response.image.at<float>(5, 7), raw.at<uint8_t>(5, 7) / vignette, 1e-3);
+  // Without exposure times (two-column times.txt) nothing is scaled.
+  MakeMono(/*zip=*/false);
+  Write("mono/times.txt", "0 100.0\n1 100.05\n2 100.1\n3 100.15\n");
+  const Frame no_exposure = OpenDataset(Path("mono"))->Load(3);
+  EXPECT_DOUBLE_EQ(no_exposure.exposure_ms, 0.0);
+  EXPECT_NEAR(no_exposure.image.at<float>(5, 7), Expected(raw.at<uint8_t>(5, 7), 7), 1e-3);
 }
 
 TEST_F(MonoVoTest, ZipImagesAreReadThroughLibzip) {

@@ -13,6 +13,7 @@
 #include <iterator>
 #include <limits>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -271,7 +272,36 @@ TEST(SyntheticTest, RenderingIsDeterministic) {
     EXPECT_EQ(ReadBytes(entry.path()), ReadBytes(root / "b" / relative)) << relative;
     ++files;
   }
-  EXPECT_EQ(files, 2 * 3 + 6);  // rgb, depth PNGs + 6 text files
+  EXPECT_EQ(files, 2 * 3 + 7);  // rgb, depth PNGs + 7 text files
+  std::filesystem::remove_all(root);
+}
+
+TEST(SyntheticTest, LightingFileGivesEachFramesGainAndBias) {
+  // lighting.txt: the global photometric ground truth, one line per frame.
+  const std::filesystem::path root = std::filesystem::temp_directory_path() /
+                                     ("pldvo_lighting_test_" + std::to_string(::getpid()));
+  SynthOptions options = SmallOptions("lighting", 160, 120);
+  options.frames = 3;
+  const SyntheticSequence sequence = MakeSequence(options);
+  WriteSequence(sequence, root.string());
+  std::ifstream file(root / "lighting.txt");
+  std::string line;
+  int frame = 0;
+  while (std::getline(file, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    double timestamp = 0.0, gain = 0.0, bias = 0.0;
+    ASSERT_TRUE(fields >> timestamp >> gain >> bias) << line;
+    ASSERT_LT(frame, options.frames);
+    const double time = sequence.ground_truth[frame].timestamp;
+    const Lighting lighting = LightingAt(sequence, time);
+    EXPECT_NEAR(timestamp, time, 1e-6);
+    EXPECT_NEAR(gain, lighting.gain, 1e-8);
+    EXPECT_NEAR(bias, lighting.bias, 1e-7);
+    EXPECT_NE(gain, 1.0);  // the lighting preset varies its gain
+    ++frame;
+  }
+  EXPECT_EQ(frame, options.frames);
   std::filesystem::remove_all(root);
 }
 
