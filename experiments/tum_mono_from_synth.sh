@@ -21,8 +21,11 @@ for file in rgb.txt lighting.txt camera.yaml; do
   fi
 done
 mkdir -p "$dst/images"
-grep -v '^#' "$src/rgb.txt" | awk -v src="$src" -v dst="$dst" \
-  '{ printf "ln -sf %s/%s %s/images/%05d.png\n", src, $2, dst, NR - 1 }' | sh
+index=0
+grep -v '^#' "$src/rgb.txt" | while read -r _ file; do
+  ln -sf "$src/$file" "$dst/images/$(printf %05d.png "$index")"
+  index=$((index + 1))
+done
 grep -v '^#' "$src/lighting.txt" | awk '{ printf "%d %s %.6f\n", NR - 1, $1, 10.0 * $2 }' \
   >"$dst/times.txt"
 value() { awk -v key="$1:" '$1 == key { print $2 }' "$src/camera.yaml"; }
