@@ -6,13 +6,16 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <mutex>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+#include <utility>
 
 #include "core/camera_yaml.h"
 #include "core/dataset_util.h"
+#include "core/evaluation.h"
 
 namespace pldvo {
 namespace {
@@ -355,17 +358,13 @@ std::vector<float> ReadInverseResponse(const std::string& path) {
   return inverse_response;
 }
 
-// The median of the positive exposure times (the upper median for an even count); 0 when none
-// is positive (times.txt without exposures).
+// The median of the positive exposure times; 0 when none is positive (times.txt without
+// exposures).
 double MedianPositive(const std::vector<double>& exposures_ms) {
   std::vector<double> positive;
-  for (const double t : exposures_ms) {
-    if (t > 0.0) positive.push_back(t);
-  }
-  if (positive.empty()) return 0.0;
-  const auto middle = positive.begin() + positive.size() / 2;
-  std::nth_element(positive.begin(), middle, positive.end());
-  return *middle;
+  std::copy_if(exposures_ms.begin(), exposures_ms.end(), std::back_inserter(positive),
+               [](double t) { return t > 0.0; });
+  return Median(std::move(positive));
 }
 
 // vignette.png (8 or 16 bit), normalised by its maximum; returns 1 / max(V, kMinVignette).

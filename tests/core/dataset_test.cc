@@ -328,9 +328,9 @@ class MonoVoTest : public DatasetTest {
     return static_cast<float>(g / vignette);
   }
 
-  // The exposure factor t_ref / t_i of frame i: exposures 10, 11, 12, 13 ms, t_ref their upper
-  // median 12 ms.
-  static double ExposureScale(int i) { return 12.0 / (10.0 + i); }
+  // The exposure factor t_ref / t_i of frame i: exposures 10, 11, 12, 13 ms, t_ref their median
+  // 11.5 ms.
+  static double ExposureScale(int i) { return 11.5 / (10.0 + i); }
 
   void ExpectPhotometricallyCorrected(const Dataset& dataset) const {
     ASSERT_EQ(dataset.size(), 4);
