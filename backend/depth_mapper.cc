@@ -233,14 +233,15 @@ SemiDenseDepthMap DepthMapper::RegularizedMap(bool smooth, bool line_regularize,
 }
 
 PropagationStats DepthMapper::PropagateToNewKeyframe(const cv::Mat& image, const EdgeTrace& edges,
-                                                     const SE3& new_from_old) {
+                                                     const SE3& new_from_old,
+                                                     const AffineBrightness& brightness) {
   const SemiDenseDepthMap old_map =
       RegularizedMap(options_.regularize, options_.line_regularization);
   const ImagePyramid old_keyframe = keyframe_;
   SetKeyframe(image, edges);
   PropagationStats stats;
   map_ = PropagateDepthMap(old_map, old_keyframe, keyframe_, edges_.id_map, camera_, new_from_old,
-                           options_, &stats);
+                           options_, &stats, brightness);
   return stats;
 }
 

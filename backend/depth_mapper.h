@@ -101,9 +101,11 @@ class DepthMapper {
                                    LineRegularizationStats* stats = nullptr) const;
 
   // Makes `image` the keyframe with the propagated RegularizedMap(options.regularize,
-  // options.line_regularization); new_from_old maps the old keyframe into the new one.
+  // options.line_regularization); new_from_old maps the old keyframe into the new one, and
+  // `brightness` is the new keyframe's relative to the old one (PropagateDepthMap).
   PropagationStats PropagateToNewKeyframe(const cv::Mat& image, const EdgeTrace& edges,
-                                          const SE3& new_from_old);
+                                          const SE3& new_from_old,
+                                          const AffineBrightness& brightness = {});
 
   const SemiDenseDepthMap& depth_map() const { return map_; }
   const ImagePyramid& keyframe() const { return keyframe_; }

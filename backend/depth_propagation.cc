@@ -10,7 +10,8 @@ SemiDenseDepthMap PropagateDepthMap(const SemiDenseDepthMap& old_map,
                                     const ImagePyramid& new_keyframe,
                                     const cv::Mat& new_edge_id_map, const PinholeCamera& camera,
                                     const SE3& new_from_old, const MappingOptions& options,
-                                    PropagationStats* stats) {
+                                    PropagationStats* stats,
+                                    const AffineBrightness& new_from_old_brightness) {
   if (old_keyframe.num_levels() < 1 || old_keyframe.width(0) != old_map.width() ||
       old_keyframe.height(0) != old_map.height() || new_keyframe.num_levels() < 1) {
     throw std::invalid_argument("PropagateDepthMap: keyframe and map sizes differ");
@@ -19,6 +20,7 @@ SemiDenseDepthMap PropagateDepthMap(const SemiDenseDepthMap& old_map,
   PropagationStats& s = stats ? *stats : local;
   s = PropagationStats();
   SemiDenseDepthMap new_map(new_keyframe.width(0), new_keyframe.height(0));
+  const double inverse_gain = std::exp(-new_from_old_brightness.a);
   new_map.SelectPixels(new_keyframe, new_edge_id_map, options);
   const Eigen::Matrix3d rotation = new_from_old.rotation_matrix();
   const Eigen::Vector3d& translation = new_from_old.translation();
@@ -50,7 +52,9 @@ SemiDenseDepthMap PropagateDepthMap(const SemiDenseDepthMap& old_map,
         continue;
       }
       const double intensity_old = old_keyframe.level(0).ptr<float>(y)[3 * x];
-      const double intensity_new = new_keyframe.SampleIntensity(0, pixel.x(), pixel.y());
+      const double intensity_new =
+          inverse_gain *
+          (new_keyframe.SampleIntensity(0, pixel.x(), pixel.y()) - new_from_old_brightness.b);
       if (std::abs(intensity_new - intensity_old) > options.max_propagation_intensity_diff) {
         ++s.dropped_intensity;
         continue;

@@ -7,7 +7,9 @@
 // which for a pure translation along the optical axis is Engel's (d1 / d0)^4 V0 + sigma_p^2.
 // A hypothesis is dropped when x' leaves the image (border), is not a candidate of the new
 // keyframe (low gradient, no edge), or the two keyframes' intensities at x and x' differ by more
-// than max_propagation_intensity_diff (occlusion, wrong depth). Collisions (two hypotheses on one
+// than max_propagation_intensity_diff (occlusion, wrong depth; the new keyframe's intensity taken
+// to the old one's brightness, e^-a (I_new - b), with `new_from_old_brightness` = (a, b):
+// residuals/affine_brightness.h). Collisions (two hypotheses on one
 // new pixel): statistically compatible ones ((d_a - d_b)^2 <= g^2 (V_a + V_b), g =
 // outlier_gate_sigmas) are fused as in the EKF; otherwise the nearer one (larger inverse depth)
 // wins, as it occludes the other.
@@ -21,6 +23,7 @@
 #include "core/image_pyramid.h"
 #include "core/pinhole_camera.h"
 #include "core/se3.h"
+#include "residuals/affine_brightness.h"
 
 namespace pldvo {
 
@@ -40,7 +43,8 @@ SemiDenseDepthMap PropagateDepthMap(const SemiDenseDepthMap& old_map,
                                     const ImagePyramid& new_keyframe,
                                     const cv::Mat& new_edge_id_map, const PinholeCamera& camera,
                                     const SE3& new_from_old, const MappingOptions& options,
-                                    PropagationStats* stats);
+                                    PropagationStats* stats,
+                                    const AffineBrightness& new_from_old_brightness = {});
 
 }  // namespace pldvo
 

@@ -189,7 +189,8 @@ void MappingWorker::Run(const MappingJob& job) {
         break;
       case MappingJob::Kind::kUpdate:
         if (job.keyframe_id != keyframe_id_) return;  // for a keyframe no longer current
-        mapper_.UpdateWithFrame(job.image, job.cur_from_kf, job.lines_in_cur);
+        mapper_.UpdateWithFrame(InReferenceBrightness(job.image, job.brightness), job.cur_from_kf,
+                                job.lines_in_cur);
         ++num_updates_;
         break;
       case MappingJob::Kind::kLineDepths: {
@@ -215,7 +216,7 @@ void MappingWorker::Run(const MappingJob& job) {
           published->retired_keyframe_id = keyframe_id_;
         }
         published->propagation =
-            mapper_.PropagateToNewKeyframe(job.image, job.edges, job.new_from_old);
+            mapper_.PropagateToNewKeyframe(job.image, job.edges, job.new_from_old, job.brightness);
         if (mapper_.depth_map().CountValid() < job.min_propagated_points) {
           mapper_.InitializeKeyframe(job.image, job.edges);
           published->random_init = true;

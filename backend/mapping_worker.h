@@ -26,6 +26,7 @@
 #include "core/pinhole_camera.h"
 #include "core/se3.h"
 #include "frontend/edge_tracer.h"
+#include "residuals/affine_brightness.h"
 
 namespace pldvo {
 
@@ -52,6 +53,11 @@ struct MappingJob {
   int keyframe_id = -1;  // the keyframe the job concerns (the new one for kNewKeyframe)
   int frame_index = -1;
   cv::Mat image;  // CV_32F or CV_8U, the camera's size
+  // The image's brightness relative to the current keyframe's (residuals/affine_brightness.h):
+  // kUpdate stereo compares the keyframe with e^-a (I - b); kNewKeyframe propagation compares
+  // the old keyframe's intensities with the new one's taken to the old brightness. Every
+  // keyframe keeps its own image.
+  AffineBrightness brightness;
   // kUpdate: cur_from_kf of the tracked frame and its lines matched to the keyframe edges.
   SE3 cur_from_kf;
   std::vector<MatchedLine> lines_in_cur;

@@ -199,6 +199,10 @@ void Odometry::StartKeyframe(int index, double timestamp, const cv::Mat& image, 
   job.keyframe_id = next_keyframe_id_++;
   job.frame_index = index;
   job.image = image;
+  // The new keyframe relative to the old one (its propagation's intensity test); the frames
+  // after it start from the new keyframe's own brightness.
+  job.brightness = brightness_;
+  brightness_ = AffineBrightness();
   job.num_levels = config_.odometry.num_levels;
   job.new_from_old = new_from_old;
   job.min_propagated_points = min_propagated_points;
@@ -345,7 +349,8 @@ TrackingResult Odometry::TrackWithAlternatives(const ImagePyramid& pyramid, cons
       observer_->OnTrackingIteration(index, image, iteration);
     };
   }
-  TrackingResult best = tracker_.Track(reference_, pyramid, prior_cur_from_kf, callback);
+  TrackingResult best =
+      tracker_.Track(reference_, pyramid, prior_cur_from_kf, brightness_, callback);
   *tried = 1;
   const OdometryOptions& options = config_.odometry;
   if (!options.try_alternatives || !retry_trigger_.ShouldRetry(best)) return best;
@@ -359,7 +364,7 @@ TrackingResult Odometry::TrackWithAlternatives(const ImagePyramid& pyramid, cons
     }
   }
   for (const SE3& guess : guesses) {
-    TrackingResult result = tracker_.Track(reference_, pyramid, guess, callback);
+    TrackingResult result = tracker_.Track(reference_, pyramid, guess, brightness_, callback);
     ++*tried;
     if (Better(result, best)) best = std::move(result);
   }
@@ -441,7 +446,8 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, PreparedFrame
           tracking.cur_from_ref, config_.odometry.line_outlier_px, &reference_, &lines_in_cur);
       result.num_line_outliers += outliers;
       if (outliers > 0) {
-        TrackingResult again = tracker_.Track(reference_, pyramid, tracking.cur_from_ref);
+        TrackingResult again =
+            tracker_.Track(reference_, pyramid, tracking.cur_from_ref, tracking.brightness);
         if (again.status != TrackingStatus::kLost) tracking = std::move(again);
       }
     }
@@ -449,7 +455,7 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, PreparedFrame
     if (compare_tracker_ != nullptr && tracking.status != TrackingStatus::kLost) {
       start = WallClock::now();
       const TrackingResult other =
-          compare_tracker_->Track(reference_, pyramid, tracking.initial_cur_from_ref);
+          compare_tracker_->Track(reference_, pyramid, tracking.initial_cur_from_ref, brightness_);
       timing.compare_tracking_ms = MsSince(start);
       result.compared = true;
       result.compared_status = other.status;
@@ -466,6 +472,7 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, PreparedFrame
                            static_cast<double>(frames));
       world_from_last_good_ = world_from_cur;
       last_good_index_ = index;
+      brightness_ = tracking.brightness;
       retry_trigger_.Update(tracking);
       result.world_from_cam = world_from_cur;
       result.status = recovering_ ? FrameStatus::kRecovered : FrameStatus::kTracked;
@@ -501,6 +508,7 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, PreparedFrame
         job.frame_index = index;
         job.image = image;
         job.cur_from_kf = cur_from_kf;
+        job.brightness = brightness_;
         job.lines_in_cur = std::move(lines_in_cur);
         timing.wait_ms += mapper_->Submit(std::move(job));
       }

@@ -175,6 +175,10 @@ class Odometry {
   SE3 world_from_last_good_;
   int last_good_index_ = -1;
   SE3 velocity_;
+  // The last good frame's brightness relative to the keyframe's (tracking.problem.brightness
+  // affine; 0 with none and after a new keyframe): the next frame's initial guess, and what its
+  // mapping job undoes (MappingJob::brightness).
+  AffineBrightness brightness_;
   RetryTrigger retry_trigger_;
   int consecutive_lost_ = 0;
   bool recovering_ = false;   // a frame was lost since the last tracked one

@@ -24,6 +24,7 @@
 #include "backend/tracking_reference.h"
 #include "core/image_pyramid.h"
 #include "core/options.h"
+#include "residuals/affine_brightness.h"
 #include "residuals/photometric_residual.h"
 #include "residuals/weighting.h"
 
@@ -38,6 +39,15 @@ struct ProblemBuilderOptions {
   // bilinear (C0 cost, interpolated central-difference gradient) or bicubic (Keys / Catmull-Rom,
   // C1 cost, exact derivative as gradient). Measurements: docs/tracking.md.
   ImageInterpolation interpolation = ImageInterpolation::kBilinear;
+  // Brightness transfer estimated with the pose (residuals/affine_brightness.h): none (the
+  // semi-dense VO's I_ref - I_cur) or affine (DSO's model I_cur ~ e^a I_ref + b, in the
+  // symmetric residual of residuals/photometric_residual.h), with a weak zero-mean prior of
+  // these standard deviations on a and b: the change of exposure expected between a keyframe
+  // and its frames, about +-10% and +-10 gray levels (docs/tracking.md, "Affine brightness":
+  // with 0.5 / 50 the pair drifts along its degenerate direction on KITTI).
+  BrightnessModel brightness = BrightnessModel::kNone;
+  double brightness_prior_sigma_a = 0.1;
+  double brightness_prior_sigma_b = 10.0;
   WeightingOptions weighting;
 
   template <class Visitor>
@@ -46,6 +56,13 @@ struct ProblemBuilderOptions {
     v.Choice("interpolation", &interpolation, ImageInterpolationNames(),
              "Photometric sampling of the current image: bilinear (C0 cost) or bicubic (C1 "
              "cost, exact Jacobian).");
+    v.Choice("brightness", &brightness, BrightnessModelNames(),
+             "Brightness transfer estimated with the pose: none (I_ref - I_cur) or affine "
+             "(I_cur ~ e^a I_ref + b; residual e^(-a/2) (e^a I_ref + b - I_cur)).");
+    v.Field("brightness_prior_sigma_a", &brightness_prior_sigma_a,
+            "Standard deviation of the zero-mean prior on the log-gain a (affine).");
+    v.Field("brightness_prior_sigma_b", &brightness_prior_sigma_b,
+            "Standard deviation of the zero-mean prior on the bias b, gray levels (affine).");
     v.Section("weighting", &weighting, "Weighting of the residual families and robust loss.");
   }
   std::string Check() const;
@@ -62,11 +79,12 @@ class ProblemBuilder {
  public:
   virtual ~ProblemBuilder() = default;
   // Adds `cur_from_ref` (double[7], SE3Manifold) as a parameter block if `problem` does not
-  // have it yet, then the residual blocks of `level`, weighted at the pose it currently holds.
+  // have it yet (and with brightness affine `brightness`, double[2] = {a, b}; ignored with
+  // none), then the residual blocks of `level`, weighted at the pose it currently holds.
   // `reference` and `current` must outlive `problem`. Throws std::invalid_argument when the
-  // level exists in neither.
+  // level exists in neither, or when affine brightness gets no block.
   virtual BuildStatistics Build(const TrackingReference& reference, const ImagePyramid& current,
-                                int level, double* cur_from_ref,
+                                int level, double* cur_from_ref, double* brightness,
                                 LeastSquaresProblem* problem) const = 0;
 };
 

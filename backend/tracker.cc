@@ -150,6 +150,7 @@ Tracker::Tracker(const TrackingOptions& options) : options_(options) {
 
 TrackingResult Tracker::Track(const TrackingReference& reference, const ImagePyramid& current,
                               const SE3& initial_cur_from_ref,
+                              const AffineBrightness& initial_brightness,
                               const TrackingIterationCallback& callback) const {
   const int available = std::min(reference.num_levels(), current.num_levels());
   if (available <= options_.finest_level) {
@@ -161,12 +162,14 @@ TrackingResult Tracker::Track(const TrackingReference& reference, const ImagePyr
 
   double pose[kPoseAmbientSize];
   PoseToParameters(initial_cur_from_ref, pose);
+  double brightness[kBrightnessSize] = {initial_brightness.a, initial_brightness.b};
   const auto start = WallClock::now();
   TrackingResult result;
   result.initial_cur_from_ref = initial_cur_from_ref;
   for (int level = coarsest; level >= options_.finest_level; --level) {
     LeastSquaresProblem problem;
-    const BuildStatistics built = builder_->Build(reference, current, level, pose, &problem);
+    const BuildStatistics built =
+        builder_->Build(reference, current, level, pose, brightness, &problem);
     LevelResult level_result;
     level_result.level = level;
     level_result.residual_rows = built.photometric_residuals + built.line_residuals;
@@ -216,6 +219,7 @@ TrackingResult Tracker::Track(const TrackingReference& reference, const ImagePyr
   }
 
   result.cur_from_ref = PoseFromParameters(pose);
+  result.brightness = {brightness[0], brightness[1]};
   const LevelResult& finest = result.levels.back();
   result.valid_residuals = finest.valid_rows;
   result.final_rms = finest.rms;

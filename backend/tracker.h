@@ -35,6 +35,7 @@
 #include "core/image_pyramid.h"
 #include "core/options.h"
 #include "core/se3.h"
+#include "residuals/affine_brightness.h"
 
 namespace pldvo {
 
@@ -103,6 +104,9 @@ struct LevelResult {
 
 struct TrackingResult {
   SE3 cur_from_ref;
+  // The current frame's brightness relative to the reference (tracking.problem.brightness
+  // affine; the initial guess, unchanged, with none).
+  AffineBrightness brightness;
   SE3 initial_cur_from_ref;  // the initial guess this result was solved from
   double ms = 0.0;           // wall time of the Track call
   TrackingStatus status = TrackingStatus::kLost;
@@ -133,9 +137,11 @@ class Tracker {
   explicit Tracker(const TrackingOptions& options);
 
   // Aligns `current` (the current frame's pyramid) to `reference`, starting from
-  // initial_cur_from_ref. The camera of every level is the reference's.
+  // initial_cur_from_ref and (with tracking.problem.brightness affine) initial_brightness. The
+  // camera of every level is the reference's.
   TrackingResult Track(const TrackingReference& reference, const ImagePyramid& current,
                        const SE3& initial_cur_from_ref,
+                       const AffineBrightness& initial_brightness = AffineBrightness(),
                        const TrackingIterationCallback& callback = nullptr) const;
 
   const TrackingOptions& options() const { return options_; }

@@ -1,5 +1,7 @@
 #include "backend/tracking_problem_builder.h"
 
+#include <ceres/normal_prior.h>
+
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -32,6 +34,10 @@ const MatchedLine* MatchedLineOf(const TrackingReferenceLevel& ref, const Refere
 
 std::string ProblemBuilderOptions::Check() const {
   if (batch_size < 1) return "batch_size must be >= 1";
+  if (!(brightness_prior_sigma_a > 0.0) || !(brightness_prior_sigma_b > 0.0) ||
+      !std::isfinite(brightness_prior_sigma_a) || !std::isfinite(brightness_prior_sigma_b)) {
+    return "brightness_prior_sigma_a and brightness_prior_sigma_b must be positive and finite";
+  }
   return weighting.Check();
 }
 
@@ -73,7 +79,7 @@ TrackingProblemBuilder::TrackingProblemBuilder(const ProblemBuilderOptions& opti
 
 BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference,
                                               const ImagePyramid& current, int level,
-                                              double* cur_from_ref,
+                                              double* cur_from_ref, double* brightness,
                                               LeastSquaresProblem* problem) const {
   if (level < 0 || level >= reference.num_levels() || level >= current.num_levels()) {
     throw std::invalid_argument(Where(__LINE__) + "level " + std::to_string(level) +
@@ -83,6 +89,25 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
   }
   if (problem->ParameterBlockIndex(cur_from_ref) < 0) {
     problem->AddParameterBlock(cur_from_ref, kPoseAmbientSize, std::make_unique<SE3Manifold>());
+  }
+  const bool with_brightness = options_.brightness == BrightnessModel::kAffine;
+  std::vector<double*> photometric_blocks = {cur_from_ref};
+  if (with_brightness) {
+    if (brightness == nullptr) {
+      throw std::invalid_argument(Where(__LINE__) + "brightness affine needs a brightness block");
+    }
+    photometric_blocks.push_back(brightness);
+    if (problem->ParameterBlockIndex(brightness) < 0) {
+      problem->AddParameterBlock(brightness, kBrightnessSize);
+      // The prior a ~ N(0, sigma_a^2), b ~ N(0, sigma_b^2) (ProblemBuilderOptions): it keeps
+      // {a, b} determined where the intensities span a narrow range (only e^a I + b there is).
+      Eigen::Matrix2d sqrt_information = Eigen::Matrix2d::Zero();
+      sqrt_information(0, 0) = 1.0 / options_.brightness_prior_sigma_a;
+      sqrt_information(1, 1) = 1.0 / options_.brightness_prior_sigma_b;
+      problem->AddResidualBlock(
+          std::make_unique<ceres::NormalPrior>(sqrt_information, Eigen::Vector2d::Zero()), nullptr,
+          {brightness});
+    }
   }
   const TrackingReferenceLevel& ref = reference.levels[level];
   const PinholeCamera& camera = ref.camera;
@@ -107,8 +132,8 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
       ++stats.residual_blocks;
       problem->AddResidualBlock(std::unique_ptr<ceres::CostFunction>(PhotometricResidual::Create(
                                     current, level, camera, std::move(observations), loss_inside,
-                                    options_.interpolation)),
-                                loss_outside, {cur_from_ref});
+                                    options_.interpolation, options_.brightness)),
+                                loss_outside, photometric_blocks);
       observations.clear();
       observations.reserve(batch);
     };

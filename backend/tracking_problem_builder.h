@@ -12,6 +12,10 @@
 // (photometric_only, line_only) is not added, nor is a row whose weight is 0 at the
 // linearisation point (reprojection invalid there).
 //
+// With brightness affine the photometric rows also read the brightness block {a, b}
+// (residuals/affine_brightness.h), which gets the prior N(0, diag(sigma_a^2, sigma_b^2)) as a
+// ceres::NormalPrior block.
+//
 // Layout: consecutive rows are grouped into blocks of `batch_size` rows sharing the pose block,
 // with the robust loss applied row-wise in square-root form inside the cost functions. With
 // `loss_in_problem` (registry name "tracking_ceres_loss") every row is its own block and the
@@ -31,7 +35,8 @@ class TrackingProblemBuilder : public ProblemBuilder {
   TrackingProblemBuilder(const ProblemBuilderOptions& options, bool loss_in_problem);
 
   BuildStatistics Build(const TrackingReference& reference, const ImagePyramid& current, int level,
-                        double* cur_from_ref, LeastSquaresProblem* problem) const override;
+                        double* cur_from_ref, double* brightness,
+                        LeastSquaresProblem* problem) const override;
 
  private:
   // line_error_model shared_per_edge: one block per matched edge, its rows whitened against the

@@ -198,8 +198,10 @@ int RunOdometryCommand(const CommandContext& context) {
   };
   trajectory_file << "# pldvo run: timestamp tx ty tz qx qy qz qw (world_from_cam), dataset "
                   << FLAGS_dataset << "\n";
-  timing_file << "index,timestamp,status,keyframe_id,lines,matches,line_outliers,reference_points,"
-                 "alternatives,iterations,final_rms,inlier_fraction,intensity_correlation";
+  timing_file
+      << "index,timestamp,status,keyframe_id,lines,matches,line_outliers,reference_points,"
+         "alternatives,iterations,final_rms,inlier_fraction,intensity_correlation,brightness_a,"
+         "brightness_b";
   for (const char* key : kTimingKeys) timing_file << "," << key << "_ms";
   timing_file << "\n";
   if (!written(trajectory_file, "trajectory.txt") || !written(timing_file, "timing.csv")) return 1;
@@ -343,7 +345,8 @@ int RunOdometryCommand(const CommandContext& context) {
                 << "," << result.num_reference_points << "," << result.alternatives_tried << ","
                 << result.tracking.TotalIterations() << "," << std::setprecision(6)
                 << result.tracking.final_rms << "," << result.tracking.inlier_fraction << ","
-                << result.tracking.intensity_correlation;
+                << result.tracking.intensity_correlation << "," << result.tracking.brightness.a
+                << "," << result.tracking.brightness.b;
     for (double value : Values(row)) timing_file << "," << std::setprecision(4) << value;
     timing_file << "\n";
     if (!written(timing_file, "timing.csv")) return 1;

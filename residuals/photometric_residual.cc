@@ -53,13 +53,15 @@ PhotometricResidual::PhotometricResidual(const ImagePyramid& cur_pyramid, int le
                                          const PinholeCamera& camera,
                                          std::vector<PhotometricObservation> observations,
                                          const ceres::LossFunction* loss,
-                                         ImageInterpolation interpolation)
+                                         ImageInterpolation interpolation,
+                                         BrightnessModel brightness)
     : cur_pyramid_(cur_pyramid),
       level_(level),
       camera_(camera),
       observations_(std::move(observations)),
       loss_(loss),
-      interpolation_(interpolation) {
+      interpolation_(interpolation),
+      brightness_(brightness) {
   if (observations_.empty()) ThrowInvalid(__LINE__, "empty batch");
   if (level < 0 || level >= cur_pyramid.num_levels()) {
     ThrowInvalid(__LINE__, "level " + std::to_string(level) + " outside the pyramid's " +
@@ -93,6 +95,9 @@ PhotometricResidual::PhotometricResidual(const ImagePyramid& cur_pyramid, int le
   valid_.assign(observations_.size(), 0);
   set_num_residuals(static_cast<int>(observations_.size()));
   mutable_parameter_block_sizes()->push_back(kPoseAmbientSize);
+  if (brightness_ == BrightnessModel::kAffine) {
+    mutable_parameter_block_sizes()->push_back(kBrightnessSize);
+  }
 }
 
 namespace {
@@ -108,13 +113,15 @@ void WithSampler(ImageInterpolation interpolation, const ImagePyramid& pyramid, 
   }
 }
 
-// One row: residual and (optionally) its tangent Jacobian. Returns validity.
+// One row: residual and (optionally) its Jacobians in the pose tangent (6) and the brightness
+// (2: a, b). Returns validity.
 template <class Sampler>
 inline bool PhotometricRow(const Sampler& sample, const PinholeCamera& camera,
                            const PhotometricObservation& o, const Eigen::Vector3d& ray_in_ref,
                            const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation,
-                           const ceres::LossFunction* loss, double* residual,
-                           double* jacobian_tangent) {
+                           double root_gain, double bias, const ceres::LossFunction* loss,
+                           double* residual, double* jacobian_tangent,
+                           double* jacobian_brightness = nullptr) {
   // q = R K^-1 (x; 1) + d t = d * point_in_cur.
   const Eigen::Vector3d q = rotation * ray_in_ref + o.idepth * translation;
   const double u_over = q.x() / q.z();
@@ -126,22 +133,38 @@ inline bool PhotometricRow(const Sampler& sample, const PinholeCamera& camera,
   if (!(q.z() > 0.0) || !(u >= kSamplingBorder && v >= kSamplingBorder && u < max_u && v < max_v)) {
     *residual = 0.0;
     if (jacobian_tangent != nullptr) std::fill(jacobian_tangent, jacobian_tangent + 6, 0.0);
+    if (jacobian_brightness != nullptr) {
+      std::fill(jacobian_brightness, jacobian_brightness + kBrightnessSize, 0.0);
+    }
     return false;
   }
   double intensity_cur, gx, gy;
   sample(u, v, jacobian_tangent != nullptr, &intensity_cur, &gx, &gy);
+  // e^{-a/2} (e^a I_ref + b - I_cur) with root_gain = e^{a/2}, bias = b (the header's symmetric
+  // form); I_ref - I_cur exactly when a = b = 0.
+  const double inverse_root_gain = 1.0 / root_gain;
   double scale;
-  *residual = RobustifyRow(loss, o.sqrt_info * (o.intensity_ref - intensity_cur), &scale);
+  *residual = RobustifyRow(
+      loss,
+      o.sqrt_info * (root_gain * o.intensity_ref + inverse_root_gain * (bias - intensity_cur)),
+      &scale);
   if (jacobian_tangent != nullptr) {
     // c = g^T dpi/dq (1x3); dr/dxi = -w [d c, (q x c)^T] since c^T (-[q]x) = (q x c)^T.
     const double inv_z = 1.0 / q.z();
     const double gfx = gx * camera.fx * inv_z;
     const double gfy = gy * camera.fy * inv_z;
     const Eigen::Vector3d c(gfx, gfy, -(gfx * u_over + gfy * v_over));
-    const double w = -o.sqrt_info * scale;
+    const double w = -o.sqrt_info * scale * inverse_root_gain;
     Eigen::Map<Eigen::Matrix<double, 6, 1>> row(jacobian_tangent);
     row.head<3>() = (w * o.idepth) * c;
     row.tail<3>() = w * q.cross(c);
+  }
+  if (jacobian_brightness != nullptr) {
+    // dr/da = w (e^{a/2} I_ref - e^{-a/2} (b - I_cur)) / 2, dr/db = w e^{-a/2}.
+    const double w = o.sqrt_info * scale;
+    jacobian_brightness[0] =
+        0.5 * w * (root_gain * o.intensity_ref - inverse_root_gain * (bias - intensity_cur));
+    jacobian_brightness[1] = w * inverse_root_gain;
   }
   return true;
 }
@@ -153,16 +176,21 @@ bool PhotometricResidual::Evaluate(double const* const* parameters, double* resi
   const SE3 cur_from_ref = PoseFromParameters(parameters[0]);
   const Eigen::Matrix3d rotation = cur_from_ref.rotation_matrix();
   const Eigen::Vector3d& translation = cur_from_ref.translation();
+  const bool with_brightness = brightness_ == BrightnessModel::kAffine;
+  const double root_gain = with_brightness ? std::exp(0.5 * parameters[1][0]) : 1.0;
+  const double bias = with_brightness ? parameters[1][1] : 0.0;
   double* jacobian = (jacobians != nullptr) ? jacobians[0] : nullptr;
+  double* jacobian_brightness = (jacobians != nullptr && with_brightness) ? jacobians[1] : nullptr;
   const MinusJacobianMatrix minus_jacobian =
       jacobian != nullptr ? PoseMinusJacobian(parameters[0]) : MinusJacobianMatrix::Zero();
   const int n = num_observations();
   WithSampler(interpolation_, cur_pyramid_, level_, bicubic_.get(), [&](const auto& sample) {
     double row_tangent[kPoseTangentSize];
     for (int i = 0; i < n; ++i) {
-      valid_[i] =
-          PhotometricRow(sample, camera_, observations_[i], rays_in_ref_[i], rotation, translation,
-                         loss_, residuals + i, jacobian != nullptr ? row_tangent : nullptr);
+      valid_[i] = PhotometricRow(
+          sample, camera_, observations_[i], rays_in_ref_[i], rotation, translation, root_gain,
+          bias, loss_, residuals + i, jacobian != nullptr ? row_tangent : nullptr,
+          jacobian_brightness != nullptr ? jacobian_brightness + i * kBrightnessSize : nullptr);
       if (jacobian != nullptr) {
         LiftTangentJacobian(minus_jacobian, row_tangent, 1, jacobian + i * kPoseAmbientSize);
       }
@@ -179,8 +207,8 @@ void PhotometricResidual::EvaluateTangent(const SE3& cur_from_ref, double* resid
   WithSampler(interpolation_, cur_pyramid_, level_, bicubic_.get(), [&](const auto& sample) {
     for (int i = 0; i < n; ++i) {
       const bool ok = PhotometricRow(
-          sample, camera_, observations_[i], rays_in_ref_[i], rotation, translation, loss_,
-          residuals + i,
+          sample, camera_, observations_[i], rays_in_ref_[i], rotation, translation, 1.0, 0.0,
+          loss_, residuals + i,
           jacobian_tangent != nullptr ? jacobian_tangent + i * kPoseTangentSize : nullptr);
       if (valid != nullptr) valid[i] = ok;
     }
@@ -197,7 +225,7 @@ void PhotometricResidual::IntensityErrors(const SE3& cur_from_ref, double* error
       PhotometricObservation unweighted = observations_[i];
       unweighted.sqrt_info = 1.0;
       const bool ok = PhotometricRow(sample, camera_, unweighted, rays_in_ref_[i], rotation,
-                                     translation, nullptr, errors + i, nullptr);
+                                     translation, 1.0, 0.0, nullptr, errors + i, nullptr);
       if (valid != nullptr) valid[i] = ok;
     }
   });

@@ -3,6 +3,7 @@
 // matches), from the identity pose, per solver, residual layout and photometric interpolation:
 //   Track/<solver>/<builder>/batch:<N>[/<ceres linear solver>/threads:<T>][/bicubic]
 //   [/shared_line_error] (line_error_model shared_per_edge: one block per edge)
+//   [/affine] (brightness affine: the pose and {a, b}, residuals/affine_brightness.h)
 // (no suffix: bilinear, the default).
 // The time includes building each level's problem (weights, cost functions) and solving it.
 // Run: build/experiments/benchmarks/tracking_benchmark [--benchmark_filter=...]
@@ -62,6 +63,7 @@ void RegisterAll() {
     int threads;
     ImageInterpolation interpolation = ImageInterpolation::kBilinear;
     LineErrorModel line_error_model = LineErrorModel::kPerPixel;
+    BrightnessModel brightness = BrightnessModel::kNone;
   };
   using LS = SolverOptions::CeresLinearSolver;
   const Variant variants[] = {
@@ -90,6 +92,10 @@ void RegisterAll() {
        ImageInterpolation::kBilinear, LineErrorModel::kSharedPerEdge},
       {SolverOptions::Type::kCeres, "tracking", 128, LS::kDenseNormalCholesky, 1,
        ImageInterpolation::kBilinear, LineErrorModel::kSharedPerEdge},
+      {SolverOptions::Type::kGaussNewton, "tracking", 128, LS::kDenseNormalCholesky, 1,
+       ImageInterpolation::kBilinear, LineErrorModel::kPerPixel, BrightnessModel::kAffine},
+      {SolverOptions::Type::kCeres, "tracking", 128, LS::kDenseNormalCholesky, 1,
+       ImageInterpolation::kBilinear, LineErrorModel::kPerPixel, BrightnessModel::kAffine},
   };
   for (const Variant& v : variants) {
     TrackingOptions options;
@@ -100,6 +106,7 @@ void RegisterAll() {
     options.problem.batch_size = v.batch;
     options.problem.interpolation = v.interpolation;
     options.problem.weighting.line_error_model = v.line_error_model;
+    options.problem.brightness = v.brightness;
     options.record_edge_pixels = false;
     std::string name = std::string("Track/") +
                        (v.solver == SolverOptions::Type::kCeres ? "ceres" : "gauss_newton") + "/" +
@@ -110,6 +117,7 @@ void RegisterAll() {
     }
     if (v.interpolation == ImageInterpolation::kBicubic) name += "/bicubic";
     if (v.line_error_model == LineErrorModel::kSharedPerEdge) name += "/shared_line_error";
+    if (v.brightness == BrightnessModel::kAffine) name += "/affine";
     benchmark::RegisterBenchmark(name.c_str(), BM_Track, options)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();

@@ -60,9 +60,16 @@ struct RunResult {
   Trajectory estimate;  // tracked frames
 };
 
-// Runs the first `frames` frames; frames listed in `blank` are replaced by a constant gray image.
+// Frame i's global brightness: the image is gain * I + bias.
+struct FrameLighting {
+  double gain = 1.0;
+  double bias = 0.0;
+};
+
+// Runs the first `frames` frames; frames listed in `blank` are replaced by a constant gray image,
+// and with `lighting` frame i is lit as lighting[i] says.
 RunResult RunSequence(const OdometryConfig& config, const std::vector<int>& blank = {},
-                      int frames = kFrames) {
+                      int frames = kFrames, const std::vector<FrameLighting>& lighting = {}) {
   const RenderedSequence& rendered = Sequence();
   Odometry odometry(rendered.sequence.camera, config);
   RunResult run;
@@ -70,6 +77,11 @@ RunResult RunSequence(const OdometryConfig& config, const std::vector<int>& blan
     cv::Mat image = rendered.images[i];
     if (std::find(blank.begin(), blank.end(), i) != blank.end()) {
       image = cv::Mat(image.size(), CV_32F, cv::Scalar(128.0));
+    }
+    if (!lighting.empty()) {
+      cv::Mat lit;
+      image.convertTo(lit, CV_32F, lighting[i].gain, lighting[i].bias);
+      image = lit;
     }
     const double timestamp = rendered.sequence.ground_truth[i].timestamp;
     run.frames.push_back(
@@ -286,6 +298,53 @@ TEST(OdometryTest, LongLossReinitialisesAndContinues) {
   for (const OdometryFrameResult& frame : run.frames) {
     EXPECT_TRUE(frame.world_from_cam.translation().allFinite());
   }
+}
+
+// A global gain and bias per frame (1 +- 0.2 and +-8 gray levels, period 12 frames; float
+// images, no clipping), as auto-exposure makes them. With tracking.problem.brightness affine
+// every frame is tracked within the undisturbed run's bounds, and the estimated transfer from
+// its keyframe is near the true one at the keyframe's mean intensity. Lowtex's walls are
+// nearly uniform, so the images determine the transfer near the tracked pixels' intensities,
+// and gain and bias trade along it (the gain comes out 0.02-0.07 low in log). Without the
+// model frames are lost and the error grows. Measured: with the model ATE 1.4 mm, RPE 0.82 cm/s
+// (0.72 unlit), no lost frame, worst transfer error 1.7 gray levels at the mean; without it
+// ATE 12.6 mm, RPE 3.93 cm/s, 3 lost events.
+TEST(OdometryTest, AffineBrightnessFollowsAGlobalGainAndBias) {
+  std::vector<FrameLighting> lighting(kFrames);
+  for (int i = 0; i < kFrames; ++i) {
+    lighting[i].gain = 1.0 + 0.2 * std::sin(2.0 * M_PI * i / 12.0);
+    lighting[i].bias = 8.0 * std::cos(2.0 * M_PI * i / 12.0);
+  }
+  OdometryConfig config = DeterministicConfig();
+  config.tracking.problem.brightness = BrightnessModel::kAffine;
+  const RunResult run = RunSequence(config, {}, kFrames, lighting);
+  const auto& gt = Sequence().sequence.ground_truth;
+  const EvaluationResult eval = EvaluateTrajectory(gt, run.estimate);
+  double worst_transfer = 0.0;
+  int keyframe = 0;  // the frame index of the keyframe frame i was tracked against
+  for (int i = 1; i < kFrames; ++i) {
+    const OdometryFrameResult& frame = run.frames[i];
+    ASSERT_TRUE(IsTracked(frame.status)) << "frame " << i << ": " << frame.message;
+    // keyframe k -> frame i: I_i = (g_i / g_k) (I_k - b_k) + b_i, at the keyframe's mean.
+    const FrameLighting& k = lighting[keyframe];
+    const double mean = cv::mean(Sequence().images[keyframe])[0] * k.gain + k.bias;
+    const double ratio = lighting[i].gain / k.gain;
+    const double truth = ratio * (mean - k.bias) + lighting[i].bias;
+    const AffineBrightness& estimate = frame.tracking.brightness;
+    worst_transfer =
+        std::max(worst_transfer, std::abs(std::exp(estimate.a) * mean + estimate.b - truth));
+    if (frame.status == FrameStatus::kKeyframe) keyframe = i;
+  }
+  EXPECT_EQ(run.stats.lost_events, 0);
+  EXPECT_LT(eval.ate_m, kMaxAteM);
+  EXPECT_LT(eval.rpe_cm_s, kMaxRpeCmS);
+  EXPECT_LT(eval.rpe_deg_s, kMaxRpeDegS);
+  EXPECT_LT(worst_transfer, 3.0);
+
+  config.tracking.problem.brightness = BrightnessModel::kNone;
+  const RunResult plain = RunSequence(config, {}, kFrames, lighting);
+  EXPECT_GT(plain.stats.lost_events, 0);
+  EXPECT_GT(EvaluateTrajectory(gt, plain.estimate).rpe_cm_s, 2.0 * eval.rpe_cm_s);
 }
 
 TEST(OdometryConfigTest, UnknownKeyIsAnError) {

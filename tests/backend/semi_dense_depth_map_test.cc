@@ -600,6 +600,37 @@ TEST(DepthPropagationTest, PlaneDepthIsPropagatedWithInflatedVariance) {
   }
 }
 
+// The appearance check compares the old keyframe with the new one taken to the old brightness:
+// with a new keyframe 1.3x as bright and 12 gray levels darker (float, no clipping) and no
+// motion, every hypothesis fails a 5 gray level check without the transfer and passes with it.
+TEST(DepthPropagationTest, IntensityCheckUndoesTheNewKeyframesBrightness) {
+  const PinholeCamera camera = TestCamera();
+  cv::Mat image(camera.height, camera.width, CV_32F);
+  cv::RNG rng(4);
+  rng.fill(image, cv::RNG::UNIFORM, 60.0, 180.0);
+  const ImagePyramid old_keyframe(image, 1);
+  cv::Mat brighter;
+  image.convertTo(brighter, CV_32F, 1.3, -12.0);
+  const ImagePyramid new_keyframe(brighter, 1);
+  MappingOptions options;
+  options.max_propagation_intensity_diff = 5.0;
+  SemiDenseDepthMap map(camera.width, camera.height);
+  map.SelectPixels(old_keyframe, cv::Mat(), options);
+  map.InitializeConstant(0.5, 1e-3, 20);
+  const int hypotheses = map.CountValid();
+  ASSERT_GT(hypotheses, 1000);
+  PropagationStats plain, transferred;
+  PropagateDepthMap(map, old_keyframe, new_keyframe, cv::Mat(), camera, SE3(), options, &plain);
+  PropagateDepthMap(map, old_keyframe, new_keyframe, cv::Mat(), camera, SE3(), options,
+                    &transferred, AffineBrightness{std::log(1.3), -12.0});
+  EXPECT_EQ(plain.propagated, 0);
+  EXPECT_EQ(plain.dropped_intensity + plain.dropped_outside + plain.dropped_not_candidate,
+            hypotheses);
+  EXPECT_EQ(transferred.dropped_intensity, 0);
+  EXPECT_EQ(transferred.propagated,
+            hypotheses - transferred.dropped_outside - transferred.dropped_not_candidate);
+}
+
 TEST(DepthMapIoTest, WritesPngAndPly) {
   const PinholeCamera camera = TestCamera();
   SemiDenseDepthMap map(camera.width, camera.height);

@@ -291,6 +291,78 @@ TEST_F(PhotometricResidualTest, GradientCheckerBicubicPerPixelSmallStep) {
   }
 }
 
+// Affine brightness (residuals/affine_brightness.h): both blocks against ceres::GradientChecker
+// (pose through the SE3Manifold, {a, b} Euclidean), bicubic so that the check is tight as in
+// GradientCheckerBicubicIsExactOnSmoothImage. The brightness rows e^a I_ref + b are linear in b
+// and smooth in a, so their part is exact to the numeric difference's rounding. Bounds: 1e-3
+// per entry, 1e-4 per row (of both blocks together).
+TEST_F(PhotometricResidualTest, GradientCheckerWithAffineBrightness) {
+  const double brightness[kBrightnessSize] = {0.15, -7.0};
+  for (const Loss loss_kind : {Loss::kNone, Loss::kHuber, Loss::kCauchy}) {
+    const auto loss = MakeLoss(loss_kind);
+    const PhotometricResidual cost(smooth_, 0, camera_,
+                                   MakeObservations(smooth_, 60, Placement::kRandom, 9), loss.get(),
+                                   ImageInterpolation::kBicubic, BrightnessModel::kAffine);
+    ASSERT_EQ(cost.parameter_block_sizes().size(), 2u);
+    const SE3Manifold manifold;
+    const std::vector<const ceres::Manifold*> manifolds = {&manifold, nullptr};
+    ceres::NumericDiffOptions options;
+    options.ridders_relative_initial_step_size = 1e-5;
+    const ceres::GradientChecker checker(&cost, &manifolds, options);
+    ceres::GradientChecker::ProbeResults results;
+    const double* parameters[] = {pose_, brightness};
+    EXPECT_TRUE(checker.Probe(parameters, 1e-3, &results)) << results.error_log;
+    const int n = cost.num_residuals();
+    Eigen::MatrixXd analytic(n, 8), numeric(n, 8);
+    analytic << results.local_jacobians[0], results.local_jacobians[1];
+    numeric << results.local_numeric_jacobians[0], results.local_numeric_jacobians[1];
+    double worst_row = 0.0;
+    for (int i = 0; i < n; ++i) {
+      worst_row = std::max(worst_row, (analytic.row(i) - numeric.row(i)).cwiseAbs().maxCoeff() /
+                                          analytic.row(i).cwiseAbs().maxCoeff());
+    }
+    EXPECT_LT(worst_row, 1e-4) << "loss " << static_cast<int>(loss_kind);
+  }
+}
+
+// At a = b = 0 the affine rows and pose Jacobian are the plain rows, bit for bit; at (a, b) the
+// row is e^{-a/2} times the plain row of the reference intensity e^a I_ref + b.
+TEST_F(PhotometricResidualTest, AffineBrightnessRowsAreTheTransferredPlainRows) {
+  const auto observations = MakeObservations(smooth_, 50, Placement::kRandom, 10);
+  const int n = static_cast<int>(observations.size());
+  const PhotometricResidual plain(smooth_, 0, camera_, observations);
+  const PhotometricResidual affine(smooth_, 0, camera_, observations, nullptr,
+                                   ImageInterpolation::kBilinear, BrightnessModel::kAffine);
+  Eigen::VectorXd r_plain(n), r_affine(n);
+  Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor> j_plain(n, 7), j_affine(n, 7);
+  Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor> j_brightness(n, 2);
+  const double identity[kBrightnessSize] = {0.0, 0.0};
+  const double* plain_parameters[] = {pose_};
+  const double* affine_parameters[] = {pose_, identity};
+  double* plain_jacobians[] = {j_plain.data()};
+  double* affine_jacobians[] = {j_affine.data(), j_brightness.data()};
+  ASSERT_TRUE(plain.Evaluate(plain_parameters, r_plain.data(), plain_jacobians));
+  ASSERT_TRUE(affine.Evaluate(affine_parameters, r_affine.data(), affine_jacobians));
+  EXPECT_EQ(r_plain, r_affine);
+  EXPECT_EQ(Eigen::MatrixXd(j_plain), Eigen::MatrixXd(j_affine));
+  // dr/da = w (I_ref + I_cur) / 2 = w I_ref - r / 2, dr/db = w.
+  for (int i = 0; i < n; ++i) {
+    const double w = observations[i].sqrt_info;
+    EXPECT_NEAR(j_brightness(i, 0), w * observations[i].intensity_ref - 0.5 * r_plain[i], 1e-12);
+    EXPECT_DOUBLE_EQ(j_brightness(i, 1), w);
+  }
+  const double brightness[kBrightnessSize] = {-0.2, 11.0};
+  std::vector<PhotometricObservation> transferred = observations;
+  for (PhotometricObservation& o : transferred) {
+    o.intensity_ref = std::exp(brightness[0]) * o.intensity_ref + brightness[1];
+  }
+  const PhotometricResidual transferred_plain(smooth_, 0, camera_, transferred);
+  const double* transferred_parameters[] = {pose_, brightness};
+  ASSERT_TRUE(transferred_plain.Evaluate(plain_parameters, r_plain.data(), nullptr));
+  ASSERT_TRUE(affine.Evaluate(transferred_parameters, r_affine.data(), nullptr));
+  EXPECT_LT((std::exp(-0.5 * brightness[0]) * r_plain - r_affine).cwiseAbs().maxCoeff(), 1e-12);
+}
+
 TEST_F(PhotometricResidualTest, RobustRowsSumToRobustCost) {
   const auto observations = MakeObservations(smooth_, 50, Placement::kRandom, 5);
   const int n = static_cast<int>(observations.size());
