@@ -119,9 +119,9 @@ template <class Sampler>
 inline bool PhotometricRow(const Sampler& sample, const PinholeCamera& camera,
                            const PhotometricObservation& o, const Eigen::Vector3d& ray_in_ref,
                            const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation,
-                           double root_gain, double bias, const ceres::LossFunction* loss,
-                           double* residual, double* jacobian_tangent,
-                           double* jacobian_brightness = nullptr) {
+                           double root_gain, double inverse_root_gain, double bias,
+                           const ceres::LossFunction* loss, double* residual,
+                           double* jacobian_tangent, double* jacobian_brightness = nullptr) {
   // q = R K^-1 (x; 1) + d t = d * point_in_cur.
   const Eigen::Vector3d q = rotation * ray_in_ref + o.idepth * translation;
   const double u_over = q.x() / q.z();
@@ -140,9 +140,8 @@ inline bool PhotometricRow(const Sampler& sample, const PinholeCamera& camera,
   }
   double intensity_cur, gx, gy;
   sample(u, v, jacobian_tangent != nullptr, &intensity_cur, &gx, &gy);
-  // e^{-a/2} (e^a I_ref + b - I_cur) with root_gain = e^{a/2}, bias = b (the header's symmetric
-  // form); I_ref - I_cur exactly when a = b = 0.
-  const double inverse_root_gain = 1.0 / root_gain;
+  // e^{-a/2} (e^a I_ref + b - I_cur) with root_gain = e^{a/2}, inverse_root_gain = e^{-a/2},
+  // bias = b (the header's symmetric form); I_ref - I_cur exactly when a = b = 0.
   double scale;
   *residual = RobustifyRow(
       loss,
@@ -178,6 +177,7 @@ bool PhotometricResidual::Evaluate(double const* const* parameters, double* resi
   const Eigen::Vector3d& translation = cur_from_ref.translation();
   const bool with_brightness = brightness_ == BrightnessModel::kAffine;
   const double root_gain = with_brightness ? std::exp(0.5 * parameters[1][0]) : 1.0;
+  const double inverse_root_gain = 1.0 / root_gain;
   const double bias = with_brightness ? parameters[1][1] : 0.0;
   double* jacobian = (jacobians != nullptr) ? jacobians[0] : nullptr;
   double* jacobian_brightness = (jacobians != nullptr && with_brightness) ? jacobians[1] : nullptr;
@@ -189,7 +189,8 @@ bool PhotometricResidual::Evaluate(double const* const* parameters, double* resi
     for (int i = 0; i < n; ++i) {
       valid_[i] = PhotometricRow(
           sample, camera_, observations_[i], rays_in_ref_[i], rotation, translation, root_gain,
-          bias, loss_, residuals + i, jacobian != nullptr ? row_tangent : nullptr,
+          inverse_root_gain, bias, loss_, residuals + i,
+          jacobian != nullptr ? row_tangent : nullptr,
           jacobian_brightness != nullptr ? jacobian_brightness + i * kBrightnessSize : nullptr);
       if (jacobian != nullptr) {
         LiftTangentJacobian(minus_jacobian, row_tangent, 1, jacobian + i * kPoseAmbientSize);
@@ -207,7 +208,7 @@ void PhotometricResidual::EvaluateTangent(const SE3& cur_from_ref, double* resid
   WithSampler(interpolation_, cur_pyramid_, level_, bicubic_.get(), [&](const auto& sample) {
     for (int i = 0; i < n; ++i) {
       const bool ok = PhotometricRow(
-          sample, camera_, observations_[i], rays_in_ref_[i], rotation, translation, 1.0, 0.0,
+          sample, camera_, observations_[i], rays_in_ref_[i], rotation, translation, 1.0, 1.0, 0.0,
           loss_, residuals + i,
           jacobian_tangent != nullptr ? jacobian_tangent + i * kPoseTangentSize : nullptr);
       if (valid != nullptr) valid[i] = ok;
@@ -225,7 +226,7 @@ void PhotometricResidual::IntensityErrors(const SE3& cur_from_ref, double* error
       PhotometricObservation unweighted = observations_[i];
       unweighted.sqrt_info = 1.0;
       const bool ok = PhotometricRow(sample, camera_, unweighted, rays_in_ref_[i], rotation,
-                                     translation, 1.0, 0.0, nullptr, errors + i, nullptr);
+                                     translation, 1.0, 1.0, 0.0, nullptr, errors + i, nullptr);
       if (valid != nullptr) valid[i] = ok;
     }
   });

@@ -1,8 +1,9 @@
 // The odometry on a short synthetic sequence (320x240, lowtex preset, 36 frames at 30 fps) in the
 // deterministic single-thread mode: every frame is tracked and the Sim(3)-aligned trajectory
 // error is small; a blank frame is marked lost and tracking recovers; a run of blank frames
-// triggers the re-initialisation and the odometry continues; the config tree loads the shipped
-// configs and rejects unknown keys.
+// triggers the re-initialisation and the odometry continues; with the affine brightness model a
+// global gain and bias per frame is followed; the config tree loads the shipped configs and
+// rejects unknown keys.
 #include "backend/odometry.h"
 
 #include <gtest/gtest.h>
