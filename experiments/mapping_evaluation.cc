@@ -13,6 +13,7 @@
 #include "backend/reference_builder.h"
 #include "experiments/synthetic_pairs.h"
 #include "frontend/line_frontend.h"
+#include "frontend/line_match_ground_truth.h"
 
 namespace pldvo {
 namespace {
@@ -99,8 +100,8 @@ std::vector<std::vector<MatchedLine>> GroundTruthLinesPerFrame(
 // 0.5 px of their segment that `continuous` keeps, against the depth image.
 void FrontendLines(const MapEvalConfig& config, const Frame& keyframe,
                    const std::vector<Frame>& frames, const cv::Mat& gt_idepth,
-                   const cv::Mat& continuous, KeyframeEdges* edges,
-                   std::vector<std::vector<MatchedLine>>* lines) {
+                   const cv::Mat& continuous, const PinholeCamera& camera, KeyframeEdges* edges,
+                   std::vector<std::vector<MatchedLine>>* lines, MapEvalResult* result) {
   LineFrontend frontend(config.lines);
   const LineFrame keyframe_lines = frontend.Process(keyframe.image);
   std::vector<LineMatch> all(keyframe_lines.segments.size());
@@ -118,8 +119,18 @@ void FrontendLines(const MapEvalConfig& config, const Frame& keyframe,
   }
   for (const Frame& frame : frames) {
     const LineFrame frame_lines = frontend.Process(frame.image);
-    lines->push_back(MatchedLinesFromMatches(frontend.Match(keyframe_lines, frame_lines),
-                                             frame_lines.segments,
+    const SE3 cur_from_ref = frame.world_from_cam.Inverse() * keyframe.world_from_cam;
+    std::vector<LineMatch> kept;
+    for (const LineMatch& m : frontend.Match(keyframe_lines, frame_lines)) {
+      const LineMatchTruth truth =
+          JudgeLineMatchByDepth(camera, keyframe_lines.segments[m.ref_index], keyframe.depth,
+                                cur_from_ref, frame_lines.segments[m.cur_index]);
+      result->matches_correct += truth == LineMatchTruth::kCorrect;
+      result->matches_wrong += truth == LineMatchTruth::kWrong;
+      result->matches_unverifiable += truth == LineMatchTruth::kUnverifiable;
+      if (!config.drop_wrong_matches || truth != LineMatchTruth::kWrong) kept.push_back(m);
+    }
+    lines->push_back(MatchedLinesFromMatches(kept, frame_lines.segments,
                                              static_cast<int>(keyframe_lines.segments.size())));
   }
 }
@@ -156,6 +167,7 @@ std::string MapEvalConfig::Check() const {
   if (frontend_lines && !line_sigma_sweep.empty()) {
     return "frontend_lines needs line_sigma_sweep=[] (the sweep perturbs GT lines)";
   }
+  if (drop_wrong_matches && !frontend_lines) return "drop_wrong_matches needs frontend_lines";
   if (frontend_lines && keyframe_line_sigma_px > 0.0) {
     return "keyframe_line_sigma_px perturbs GT lines, which frontend_lines does not use";
   }
@@ -194,17 +206,17 @@ MapEvalResult RunMapEvaluation(const MapEvalConfig& config,
   const cv::Mat gt_idepth = InverseDepthFromDepth(keyframe.depth);
   KeyframeEdges edges;
   std::vector<std::vector<MatchedLine>> lines;  // of the main line-guided run
+  MapEvalResult result;
   if (config.frontend_lines) {
     FrontendLines(config, keyframe, frames, gt_idepth,
                   ContinuousDepthMask(gt_idepth, config.discontinuity_radius_px,
                                       config.discontinuity_rel_step),
-                  &edges, &lines);
+                  camera, &edges, &lines, &result);
   } else {
     edges = {gt_edges.trace, gt_edges.line_idepth, gt_edges.centre_mask};
     lines =
         GroundTruthLinesPerFrame(config, gt_edges, camera, keyframe, frames, config.line_sigma_px);
   }
-  MapEvalResult result;
   result.width = camera.width;
   result.height = camera.height;
   result.frontend_lines = config.frontend_lines;
@@ -281,6 +293,14 @@ std::string FormatMapEvalTable(const MapEvalResult& r) {
                 r.width, r.height, r.num_edges, r.frontend_lines ? "frontend" : "GT",
                 r.num_edge_pixels, r.baseline_m);
   out << line;
+  if (r.frontend_lines) {
+    std::snprintf(line, sizeof(line),
+                  "frontend matches judged by the GT depth and poses: %d correct, %d wrong, %d "
+                  "unverifiable (precision %.3f)\n",
+                  r.matches_correct, r.matches_wrong, r.matches_unverifiable,
+                  r.matches_correct / std::max(1.0, 1.0 * (r.matches_correct + r.matches_wrong)));
+    out << line;
+  }
   out << "| stereo | line sigma px | hyp. | rel. err | mean NEES | median NEES | in 2 sigma | "
          "edge px | edge rel. err | edge mean NEES | edge median NEES | edge rel. err after 3D "
          "line reg. | its median NEES | smoothed rel. err | edge us/px | edge us/px frame 1 |\n"

@@ -36,6 +36,9 @@ struct MapEvalConfig {
   // of the GT edges; the edge statistics are then the frontend's traced centre pixels away from
   // GT depth discontinuities against the depth image. Needs an empty line_sigma_sweep.
   bool frontend_lines = false;
+  // frontend_lines only: leave out the matches that the depth image and the GT pose call wrong
+  // (JudgeLineMatchByDepth): the line-guided stereo with an oracle matcher.
+  bool drop_wrong_matches = false;
   LineFrontendOptions lines;
   // Best of this many timings of the edge stereo with wide priors (0 skips the timing).
   int speed_repetitions = 5;
@@ -72,6 +75,8 @@ struct MapEvalConfig {
     v.Field("frontend_lines", &frontend_lines,
             "Edges and line matches from the line frontend instead of GT (needs "
             "line_sigma_sweep=[]).");
+    v.Field("drop_wrong_matches", &drop_wrong_matches,
+            "frontend_lines: leave out the matches the GT depth and pose call wrong (oracle).");
     v.Section("synth", &synth, "Synthetic sequence.");
     v.Section("mapping", &mapping, "Mapping options.");
     v.Section("lines", &lines, "Line frontend (frontend_lines only).");
@@ -98,6 +103,9 @@ struct MapEvalRun {
 
 struct MapEvalResult {
   bool frontend_lines = false;  // the edges below are the frontend's (else the GT edges)
+  // frontend_lines: the frontend's matches over all frames, judged by JudgeLineMatchByDepth
+  // (before drop_wrong_matches).
+  int matches_correct = 0, matches_wrong = 0, matches_unverifiable = 0;
   int width = 0, height = 0, num_edges = 0, num_edge_pixels = 0;
   double baseline_m = 0.0;  // keyframe-to-last-frame distance
   MapEvalRun photometric;

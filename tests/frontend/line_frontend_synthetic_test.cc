@@ -15,6 +15,7 @@
 
 #include "core/synthetic/synthetic_sequence.h"
 #include "frontend/line_frontend.h"
+#include "frontend/line_match_ground_truth.h"
 #include "tests/frontend/line_ground_truth.h"
 #include "tests/render_cache.h"
 
@@ -270,24 +271,9 @@ TEST_F(LineFrontendSynthetic, MatchPrecisionRecallWithPredictedPosition) {
             scene.frames.at(keyframe + gap).world_from_cam.Inverse() * ref.world_from_cam;
         const PinholeCamera camera = scene.sequence.camera;
         const cv::Mat depth = ref.rendered.depth;
-        auto predict_point = [=](const Eigen::Vector2d& p, Eigen::Vector2d* q) {
-          float z = 0.f;
-          const int x0 = static_cast<int>(std::lround(p.x()));
-          const int y0 = static_cast<int>(std::lround(p.y()));
-          for (int y = std::max(0, y0 - 2); y <= std::min(depth.rows - 1, y0 + 2); ++y) {
-            for (int x = std::max(0, x0 - 2); x <= std::min(depth.cols - 1, x0 + 2); ++x) {
-              const float d = depth.at<float>(y, x);
-              if (d > 0.f && (z == 0.f || d < z)) z = d;
-            }
-          }
-          if (z <= 0.f) return false;
-          const Eigen::Vector3d point_in_cur = cur_from_ref * (z * camera.Unproject(p));
-          if (point_in_cur.z() <= 0.05) return false;
-          *q = camera.Project(point_in_cur);
-          return true;
-        };
         return [=](const LineSegment& s, Eigen::Vector2d* start, Eigen::Vector2d* end) {
-          return predict_point(s.start, start) && predict_point(s.end, end);
+          return TransferPixelByDepth(camera, depth, cur_from_ref, s.start, 2, start) &&
+                 TransferPixelByDepth(camera, depth, cur_from_ref, s.end, 2, end);
         };
       },
       "predicted");
