@@ -64,22 +64,78 @@ void DepthMapper::InitializeKeyframeFromDepth(const cv::Mat& image, const EdgeTr
   map_.InitializeFromDepth(depth, idepth_var, options_.validity_initial);
 }
 
+bool DepthMapper::PriorInterval(int index, double* idepth_min, double* idepth_max,
+                                double* idepth_centre) const {
+  *idepth_min = options_.min_idepth;
+  *idepth_max = options_.max_idepth;
+  *idepth_centre = options_.init_idepth;
+  if (!map_.valid(index)) return true;
+  const double d = map_.idepth(index);
+  const double range = options_.search_sigmas * std::sqrt(map_.idepth_var(index));
+  *idepth_min = std::max(options_.min_idepth, d - range);
+  *idepth_max = std::min(options_.max_idepth, d + range);
+  *idepth_centre = std::clamp(d, *idepth_min, *idepth_max);
+  return *idepth_max > *idepth_min;
+}
+
+StereoStatus DepthMapper::ObserveOnLine(int index, const EpipolarGeometry& geometry,
+                                        const MatchedLine& line_in_cur, double idepth_min,
+                                        double idepth_max, const ImagePyramid* current,
+                                        const EpipolarPatch* patch,
+                                        StereoObservation* observation) const {
+  const Eigen::Vector2d pixel(index % map_.width(), index / map_.width());
+  const int edge = map_.edge_id(index);
+  // The foot point of the pixel on l1 and l1's position variance there (the pixel itself and
+  // 0 when l1 is unknown).
+  Eigen::Vector2d edge_pixel = pixel;
+  double ref_line_position_var = 0.0;
+  if (edge < static_cast<int>(line_in_ref_by_id_.size())) {
+    const Eigen::Vector3d& l1 = line_in_ref_by_id_[edge];
+    edge_pixel -= (l1.x() * pixel.x() + l1.y() * pixel.y() + l1.z()) * l1.head<2>();
+    if (options_.line_stereo_keyframe_line_var) {
+      const Eigen::Vector3d foot(edge_pixel.x(), edge_pixel.y(), 1.0);
+      ref_line_position_var = foot.dot(line_cov_in_ref_by_id_[edge] * foot);
+    }
+  }
+  return LineGuidedStereo(geometry, pixel, edge_pixel, ref_line_position_var,
+                          line_in_cur.line_in_cur, idepth_min, idepth_max, options_, current, patch,
+                          observation);
+}
+
+std::vector<char> DepthMapper::InconsistentLineMatches(
+    const EpipolarGeometry& geometry, const std::vector<MatchedLine>& lines_in_cur) const {
+  std::vector<int> inside(lines_in_cur.size(), 0), outside(lines_in_cur.size(), 0);
+  for (int i = 0; i < map_.num_pixels(); ++i) {
+    const int edge = map_.edge_id(i);
+    if (edge < 0 || edge >= static_cast<int>(lines_in_cur.size()) || !lines_in_cur[edge].matched ||
+        !map_.valid(i) || !map_.candidate(i)) {
+      continue;
+    }
+    double idepth_min, idepth_max, idepth_centre;
+    if (!PriorInterval(i, &idepth_min, &idepth_max, &idepth_centre)) continue;
+    StereoObservation observation;
+    const StereoStatus status = ObserveOnLine(i, geometry, lines_in_cur[edge], idepth_min,
+                                              idepth_max, nullptr, nullptr, &observation);
+    inside[edge] += status == StereoStatus::kOk;
+    outside[edge] += status == StereoStatus::kLineOutOfRange;
+  }
+  std::vector<char> inconsistent(lines_in_cur.size(), 0);
+  for (size_t e = 0; e < lines_in_cur.size(); ++e) {
+    const int votes = inside[e] + outside[e];
+    inconsistent[e] = votes >= options_.line_match_min_votes &&
+                      outside[e] > options_.line_match_max_outside_fraction * votes;
+  }
+  return inconsistent;
+}
+
 void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
                               const EpipolarGeometry& geometry,
                               const std::vector<MatchedLine>& lines_in_cur,
                               FrameUpdateStats* stats) {
   const Eigen::Vector2d pixel(index % map_.width(), index / map_.width());
   const bool valid = map_.valid(index);
-  double idepth_min = options_.min_idepth, idepth_max = options_.max_idepth;
-  double idepth_centre = options_.init_idepth;
-  if (valid) {
-    const double d = map_.idepth(index);
-    const double range = options_.search_sigmas * std::sqrt(map_.idepth_var(index));
-    idepth_min = std::max(options_.min_idepth, d - range);
-    idepth_max = std::min(options_.max_idepth, d + range);
-    idepth_centre = std::clamp(d, idepth_min, idepth_max);
-    if (idepth_max <= idepth_min) return;
-  }
+  double idepth_min, idepth_max, idepth_centre;
+  if (!PriorInterval(index, &idepth_min, &idepth_max, &idepth_centre)) return;
   EpipolarPatch patch;
   const StereoStatus patch_status =
       MakeEpipolarPatch(keyframe_, geometry, pixel, idepth_centre, options_, &patch);
@@ -91,22 +147,8 @@ void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
                         edge < static_cast<int>(lines_in_cur.size()) && lines_in_cur[edge].matched;
   if (has_line) {
     ++stats->line_attempts;
-    // The foot point of the pixel on l1 and l1's position variance there (the pixel itself and
-    // 0 when l1 is unknown).
-    Eigen::Vector2d edge_pixel = pixel;
-    double ref_line_position_var = 0.0;
-    if (edge < static_cast<int>(line_in_ref_by_id_.size())) {
-      const Eigen::Vector3d& l1 = line_in_ref_by_id_[edge];
-      edge_pixel -= (l1.x() * pixel.x() + l1.y() * pixel.y() + l1.z()) * l1.head<2>();
-      if (options_.line_stereo_keyframe_line_var) {
-        const Eigen::Vector3d foot(edge_pixel.x(), edge_pixel.y(), 1.0);
-        ref_line_position_var = foot.dot(line_cov_in_ref_by_id_[edge] * foot);
-      }
-    }
-    status =
-        LineGuidedStereo(geometry, pixel, edge_pixel, ref_line_position_var,
-                         lines_in_cur[edge].line_in_cur, idepth_min, idepth_max, options_, &current,
-                         patch_status == StereoStatus::kOk ? &patch : nullptr, &observation);
+    status = ObserveOnLine(index, geometry, lines_in_cur[edge], idepth_min, idepth_max, &current,
+                           patch_status == StereoStatus::kOk ? &patch : nullptr, &observation);
     if (status == StereoStatus::kOk) {
       ++stats->line_ok;
       if (options_.line_stereo_refine_ssd && patch_status == StereoStatus::kOk) {
@@ -170,6 +212,20 @@ FrameUpdateStats DepthMapper::UpdateWithFrame(const cv::Mat& image, const SE3& c
   const ImagePyramid current(image, 1);
   const EpipolarGeometry geometry(camera_, cur_from_ref);
   if (!(cur_from_ref.translation().norm() > 0.0)) return stats;  // no baseline, no stereo
+  // Matches whose line most of the edge's hypotheses contradict are left out for this frame; the
+  // edge's pixels then search like pixels without a line.
+  const std::vector<MatchedLine>* lines = &lines_in_cur;
+  std::vector<MatchedLine> kept;
+  if (options_.use_line_stereo && options_.line_match_max_outside_fraction < 1.0) {
+    kept = lines_in_cur;
+    const std::vector<char> inconsistent = InconsistentLineMatches(geometry, kept);
+    for (size_t e = 0; e < kept.size(); ++e) {
+      if (!inconsistent[e]) continue;
+      kept[e].matched = false;
+      stats.dropped_line_matches.push_back(static_cast<int>(e));
+    }
+    lines = &kept;
+  }
   // Two passes (edge pixels, then the rest) so that each is timed on its own.
   for (int pass = 0; pass < 2; ++pass) {
     const auto start = WallClock::now();
@@ -177,7 +233,7 @@ FrameUpdateStats DepthMapper::UpdateWithFrame(const cv::Mat& image, const SE3& c
       if (!map_.candidate(i) || (map_.edge_id(i) >= 0) != (pass == 0)) continue;
       if (map_.blacklist(i) >= options_.blacklist_threshold) continue;
       if (pass == 0) ++stats.num_edge_pixels;
-      UpdatePixel(i, current, geometry, lines_in_cur, &stats);
+      UpdatePixel(i, current, geometry, *lines, &stats);
     }
     (pass == 0 ? stats.edge_stereo_ms : stats.other_stereo_ms) = MsSince(start);
   }

@@ -18,6 +18,8 @@
 // (SemiDenseDepthMap::Fuse, options.stereo_error_correlation); pixels
 // without a hypothesis are searched over [min_idepth, max_idepth] and initialised from the
 // observation. Then isolated hypotheses are removed and holes filled (depth_regularizer.h).
+// Optionally (options.line_match_max_outside_fraction < 1) a match is left out for the frame when
+// most of its edge's hypotheses put the line intersection outside their prior intervals.
 // Smoothing and the 3D line regularisation act on a copy (RegularizedMap), never on the filter
 // state, so that they do not count the same data twice.
 #ifndef PLDVO_BACKEND_DEPTH_MAPPER_H_
@@ -47,6 +49,9 @@ struct FrameUpdateStats {
   int line_fallback = 0;      // near-parallel: fell back to the SSD search
   int line_rejected = 0;      // out of the prior interval or failed the SSD check
   int line_out_of_range = 0;  // of which: outside the prior interval idepth +- 2 sigma
+  // Edge ids whose match was left out because most of the edge's hypotheses put the
+  // intersection outside their prior interval (options.line_match_max_outside_fraction).
+  std::vector<int> dropped_line_matches;
   int ssd_attempts = 0;
   int ssd_ok = 0;
   int fused = 0;                 // EKF updates
@@ -117,6 +122,21 @@ class DepthMapper {
 
  private:
   void SetKeyframe(const cv::Mat& image, const EdgeTrace& edges);
+  // The search interval of a pixel: its hypothesis +- search_sigmas sigma within [min_idepth,
+  // max_idepth], or that whole range without one; false when it is empty.
+  bool PriorInterval(int index, double* idepth_min, double* idepth_max,
+                     double* idepth_centre) const;
+  // Line-guided stereo (LineGuidedStereo) of a pixel of edge e against lines_in_cur[e], from the
+  // pixel's foot point on l1.
+  StereoStatus ObserveOnLine(int index, const EpipolarGeometry& geometry,
+                             const MatchedLine& line_in_cur, double idepth_min, double idepth_max,
+                             const ImagePyramid* current, const EpipolarPatch* patch,
+                             StereoObservation* observation) const;
+  // Per edge id: the match is contradicted by the edge's hypotheses (at least
+  // line_match_min_votes of them have an intersection inside or outside their prior interval,
+  // and more than line_match_max_outside_fraction of those lie outside).
+  std::vector<char> InconsistentLineMatches(const EpipolarGeometry& geometry,
+                                            const std::vector<MatchedLine>& lines_in_cur) const;
   // Stereo + fusion of one candidate pixel.
   void UpdatePixel(int index, const ImagePyramid& current, const EpipolarGeometry& geometry,
                    const std::vector<MatchedLine>& lines_in_cur, FrameUpdateStats* stats);

@@ -36,6 +36,10 @@ std::string MappingOptions::Check() const {
   if (min_line_epipolar_angle_deg < 0.0 || min_line_epipolar_angle_deg >= 90.0) {
     error << "min_line_epipolar_angle_deg must be in [0, 90); ";
   }
+  if (!(line_match_max_outside_fraction > 0.0 && line_match_max_outside_fraction <= 1.0)) {
+    error << "line_match_max_outside_fraction must be in (0, 1]; ";
+  }
+  if (line_match_min_votes < 1) error << "line_match_min_votes must be >= 1; ";
   if (!(stereo_error_correlation >= 0.0 && stereo_error_correlation < 1.0)) {
     error << "stereo_error_correlation must be in [0, 1); ";
   }

@@ -85,6 +85,11 @@ struct MappingOptions {
   // current line's in eq. 10, as a part of the observation's error that every line-guided
   // observation of the pixel shares (the same keyframe detection in every frame).
   bool line_stereo_keyframe_line_var = true;
+  // A match is left out for a frame when more than this fraction of its edge's hypotheses (and
+  // at least line_match_min_votes of them) put the intersection outside their prior interval: a
+  // wrong match (docs/mapping.md, "Wrong frontend matches on textured"). 1 = off.
+  double line_match_max_outside_fraction = 1.0;
+  int line_match_min_votes = 10;
 
   // ---- EKF fusion and outliers (Engel 2013 Sec. 2.3).
   // rho of the correlated-error fusion (SemiDenseDepthMap::Fuse, docs/mapping.md): the fraction
@@ -197,6 +202,11 @@ struct MappingOptions {
     v.Field("line_stereo_keyframe_line_var", &line_stereo_keyframe_line_var,
             "Add the keyframe line's position error to eq. 10, shared by all of the pixel's "
             "line-guided observations (default true).");
+    v.Field("line_match_max_outside_fraction", &line_match_max_outside_fraction,
+            "Leave a line match out for a frame when more than this fraction of its edge's "
+            "hypotheses put the intersection outside their prior interval (1 = off, default).");
+    v.Field("line_match_min_votes", &line_match_min_votes,
+            "Hypotheses an edge needs for that test (default 10).");
     v.Field("stereo_error_correlation", &stereo_error_correlation,
             "Fraction of a stereo observation's variance shared by all observations of the pixel "
             "(fusion floor; 0 = independent EKF; default 0.1).");

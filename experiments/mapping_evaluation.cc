@@ -31,11 +31,13 @@ struct KeyframeEdges {
   cv::Mat mask;    // CV_8U: the evaluated edge pixels
 };
 
-// lines[k]: the matched lines of frames[k], indexed by keyframe edge id.
+// lines[k]: the matched lines of frames[k], indexed by keyframe edge id; wrong_matches[k][e]
+// (frontend_lines, else empty): JudgeLineMatchByDepth called that match wrong.
 MapEvalRun RunVariant(const MapEvalConfig& config, bool line_stereo, double line_sigma_px,
                       const PinholeCamera& camera, const Frame& keyframe,
                       const std::vector<Frame>& frames, const KeyframeEdges& edges,
-                      const std::vector<std::vector<MatchedLine>>& lines) {
+                      const std::vector<std::vector<MatchedLine>>& lines,
+                      const std::vector<std::vector<char>>& wrong_matches = {}) {
   MappingOptions options = config.mapping;
   options.use_line_stereo = line_stereo;
   DepthMapper mapper(camera, options);
@@ -58,6 +60,10 @@ MapEvalRun RunVariant(const MapEvalConfig& config, bool line_stereo, double line
     run.line_fallback += stats.line_fallback;
     run.line_rejected += stats.line_rejected;
     run.line_out_of_range += stats.line_out_of_range;
+    for (int edge : stats.dropped_line_matches) {
+      ++run.line_matches_dropped;
+      run.line_matches_dropped_wrong += k < wrong_matches.size() && wrong_matches[k][edge];
+    }
     run.ssd_ok += stats.ssd_ok;
     run.outliers += stats.outliers;
   }
@@ -97,11 +103,13 @@ std::vector<std::vector<MatchedLine>> GroundTruthLinesPerFrame(
 
 // frontend_lines: every keyframe segment traced (as the odometry does), every frame's segments
 // matched to the keyframe's without a prediction; the edge statistics on the traced pixels within
-// 0.5 px of their segment that `continuous` keeps, against the depth image.
+// 0.5 px of their segment that `continuous` keeps, against the depth image. Every match is judged
+// by JudgeLineMatchByDepth (counts in `result`, (*wrong_matches)[k][edge id] when wrong).
 void FrontendLines(const MapEvalConfig& config, const Frame& keyframe,
                    const std::vector<Frame>& frames, const cv::Mat& gt_idepth,
                    const cv::Mat& continuous, const PinholeCamera& camera, KeyframeEdges* edges,
-                   std::vector<std::vector<MatchedLine>>* lines, MapEvalResult* result) {
+                   std::vector<std::vector<MatchedLine>>* lines,
+                   std::vector<std::vector<char>>* wrong_matches, MapEvalResult* result) {
   LineFrontend frontend(config.lines);
   const LineFrame keyframe_lines = frontend.Process(keyframe.image);
   std::vector<LineMatch> all(keyframe_lines.segments.size());
@@ -121,6 +129,7 @@ void FrontendLines(const MapEvalConfig& config, const Frame& keyframe,
     const LineFrame frame_lines = frontend.Process(frame.image);
     const SE3 cur_from_ref = frame.world_from_cam.Inverse() * keyframe.world_from_cam;
     std::vector<LineMatch> kept;
+    wrong_matches->emplace_back(keyframe_lines.segments.size(), 0);
     for (const LineMatch& m : frontend.Match(keyframe_lines, frame_lines)) {
       const LineMatchTruth truth =
           JudgeLineMatchByDepth(camera, keyframe_lines.segments[m.ref_index], keyframe.depth,
@@ -128,6 +137,7 @@ void FrontendLines(const MapEvalConfig& config, const Frame& keyframe,
       result->matches_correct += truth == LineMatchTruth::kCorrect;
       result->matches_wrong += truth == LineMatchTruth::kWrong;
       result->matches_unverifiable += truth == LineMatchTruth::kUnverifiable;
+      wrong_matches->back()[m.ref_index] = truth == LineMatchTruth::kWrong;
       if (!config.drop_wrong_matches || truth != LineMatchTruth::kWrong) kept.push_back(m);
     }
     lines->push_back(MatchedLinesFromMatches(kept, frame_lines.segments,
@@ -205,13 +215,14 @@ MapEvalResult RunMapEvaluation(const MapEvalConfig& config,
   const PinholeCamera& camera = sequence.camera;
   const cv::Mat gt_idepth = InverseDepthFromDepth(keyframe.depth);
   KeyframeEdges edges;
-  std::vector<std::vector<MatchedLine>> lines;  // of the main line-guided run
+  std::vector<std::vector<MatchedLine>> lines;   // of the main line-guided run
+  std::vector<std::vector<char>> wrong_matches;  // frontend_lines
   MapEvalResult result;
   if (config.frontend_lines) {
     FrontendLines(config, keyframe, frames, gt_idepth,
                   ContinuousDepthMask(gt_idepth, config.discontinuity_radius_px,
                                       config.discontinuity_rel_step),
-                  camera, &edges, &lines, &result);
+                  camera, &edges, &lines, &wrong_matches, &result);
   } else {
     edges = {gt_edges.trace, gt_edges.line_idepth, gt_edges.centre_mask};
     lines =
@@ -227,8 +238,8 @@ MapEvalResult RunMapEvaluation(const MapEvalConfig& config,
   result.baseline_m =
       (frames.back().world_from_cam.translation() - keyframe.world_from_cam.translation()).norm();
   result.photometric = RunVariant(config, false, 0.0, camera, keyframe, frames, edges, lines);
-  result.line_guided =
-      RunVariant(config, true, config.line_sigma_px, camera, keyframe, frames, edges, lines);
+  result.line_guided = RunVariant(config, true, config.line_sigma_px, camera, keyframe, frames,
+                                  edges, lines, wrong_matches);
   for (double sigma : config.line_sigma_sweep) {
     if (sigma < 0.0) throw std::invalid_argument("MapEvalConfig: line_sigma_sweep must be >= 0");
     result.line_sweep.push_back(
@@ -351,14 +362,14 @@ std::string FormatMapEvalTable(const MapEvalResult& r) {
     const MapEvalRun& run = *runs[v];
     std::snprintf(line, sizeof(line),
                   "%s: %d/%d candidates valid; line ok %d (SSD-refined %d), fallback %d, rejected "
-                  "%d (%d out of "
-                  "range); ssd ok %d; EKF outliers %d; 3D line reg: %d edges fitted, %d rejected, "
-                  "%d px updated, %d outlier px\n",
+                  "%d (%d out of range), matches dropped %d (%d of them wrong); ssd ok %d; EKF "
+                  "outliers %d; 3D line reg: %d edges fitted, %d rejected, %d px updated, %d "
+                  "outlier px\n",
                   v == 0 ? "photometric" : "line-guided", run.valid, run.candidates, run.line_ok,
                   run.line_refined, run.line_fallback, run.line_rejected, run.line_out_of_range,
-                  run.ssd_ok, run.outliers, run.line_stats.edges_fitted,
-                  run.line_stats.edges_rejected, run.line_stats.pixels_updated,
-                  run.line_stats.pixels_rejected);
+                  run.line_matches_dropped, run.line_matches_dropped_wrong, run.ssd_ok,
+                  run.outliers, run.line_stats.edges_fitted, run.line_stats.edges_rejected,
+                  run.line_stats.pixels_updated, run.line_stats.pixels_rejected);
     out << line;
   }
   if (r.wide_prior_photometric_us > 0.0) {

@@ -97,7 +97,7 @@ struct MapEvalRun {
   double first_frame_edge_us_per_pixel = 0.0;  // the same in the first frame (wide priors)
   double other_stereo_us_per_pixel = 0.0;
   int line_ok = 0, line_refined = 0, line_fallback = 0, line_rejected = 0, line_out_of_range = 0,
-      ssd_ok = 0, outliers = 0;
+      line_matches_dropped = 0, line_matches_dropped_wrong = 0, ssd_ok = 0, outliers = 0;
   int candidates = 0, valid = 0;
 };
 

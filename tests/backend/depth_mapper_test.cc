@@ -7,6 +7,8 @@
 // TexturedSeed2Result() share one evaluation: ctest runs this binary as one process (ONE_PROCESS,
 // tests/CMakeLists.txt), and the evaluations of one sequence render its frames once (the render
 // cache).
+#include "backend/depth_mapper.h"
+
 #include <gtest/gtest.h>
 
 #include <stdexcept>
@@ -14,6 +16,7 @@
 #include <utility>
 
 #include "experiments/mapping_evaluation.h"
+#include "experiments/synthetic_pairs.h"
 #include "tests/render_cache.h"
 
 namespace pldvo {
@@ -299,6 +302,57 @@ TEST(DepthMapperTest, WrongFrontendMatchesAreTheTexturedEdgeTail) {
             with_wrong.photometric.edges.median_rel_error);
   config.frontend_lines = false;
   EXPECT_THROW(Evaluate(config), std::invalid_argument);
+}
+
+TEST(DepthMapperTest, LineMatchContradictedByTheMapIsLeftOut) {
+  // A keyframe from its GT depth (sigma 0.01 per metre; traced pixels hold the depth of their 3D
+  // line, as line-guided stereo leaves them), its GT edges and the exact GT lines of frame 10, but
+  // one edge's line moved 6 px along its normal (a wrong match, like a neighbouring texture line).
+  // Its intersections leave every pixel's prior interval, so with
+  // line_match_max_outside_fraction 0.8 that match alone is left out; off (1), none is.
+  const synthetic::SyntheticSequence sequence =
+      synthetic_pairs::MakeScaledSequence("textured", 11, 1, 320, 240);
+  const PinholeCamera& camera = sequence.camera;
+  const synthetic::RenderedFrame keyframe = test::RenderFrameForTest(sequence, 0);
+  const cv::Mat image = test::RenderFrameForTest(sequence, 10).image;
+  const SE3& world_from_ref = sequence.ground_truth[0].world_from_cam;
+  const SE3 cur_from_ref = sequence.ground_truth[10].world_from_cam.Inverse() * world_from_ref;
+  const GroundTruthEdges edges =
+      MakeGroundTruthEdges(synthetic_pairs::SegmentsInCam(sequence.scene, world_from_ref.Inverse()),
+                           keyframe.depth, camera, GroundTruthEdgeOptions());
+  cv::Mat depth = keyframe.depth.clone();
+  for (int y = 0; y < depth.rows; ++y) {
+    for (int x = 0; x < depth.cols; ++x) {
+      const float line_idepth = edges.line_idepth.at<float>(y, x);
+      if (line_idepth > 0.f) depth.at<float>(y, x) = 1.f / line_idepth;
+    }
+  }
+  std::vector<MatchedLine> lines = ProjectGroundTruthLines(edges, camera, cur_from_ref, 0.0, 1);
+  int wrong = -1;
+  size_t most_pixels = 0;
+  for (const TracedLine& line : edges.trace.lines) {
+    if (line.id < static_cast<int>(lines.size()) && lines[line.id].matched &&
+        line.pixels.size() > most_pixels) {
+      most_pixels = line.pixels.size();
+      wrong = line.id;
+    }
+  }
+  ASSERT_GE(wrong, 0);
+  ASSERT_GT(most_pixels, 50u);
+  lines[wrong].line_in_cur.line.z() -= 6.0;  // l = (a, b, c) with a^2 + b^2 = 1
+  for (double fraction : {0.5, 1.0}) {
+    MappingOptions options;
+    options.line_match_max_outside_fraction = fraction;
+    DepthMapper mapper(camera, options);
+    mapper.InitializeKeyframeFromDepth(keyframe.image, edges.trace, depth, 1e-4);
+    const FrameUpdateStats stats = mapper.UpdateWithFrame(image, cur_from_ref, lines);
+    EXPECT_GT(stats.line_ok, 1000);
+    if (fraction < 1.0) {
+      EXPECT_EQ(stats.dropped_line_matches, std::vector<int>{wrong});
+    } else {
+      EXPECT_TRUE(stats.dropped_line_matches.empty());
+    }
+  }
 }
 
 TEST(DepthMapperTest, PropagationKeepsAccuracy) {
