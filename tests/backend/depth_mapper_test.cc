@@ -283,20 +283,26 @@ TEST(DepthMapperTest, WrongFrontendMatchesAreTheTexturedEdgeTail) {
   // and the same mapping with the wrong ones left out (an oracle matcher): `pldvo mapeval --set
   // synth.seed=2 --set line_sigma_sweep=[] --set frontend_lines=true [--set
   // drop_wrong_matches=true]`. Measured: 916 correct, 103 wrong, 27 unverifiable (precision
-  // 0.899); line-guided edge gross fraction 4.82% -> 0.84%, edge mean NEES 55.9 -> 6.1.
+  // 0.899); line-guided edge gross fraction 4.82% -> 0.84%, edge mean NEES 55.9 -> 6.1. The
+  // bounds (more than 4% wrong, the oracle at most 0.6x) hold for the sanitizers' 8 frames too.
   MapEvalConfig config = SequenceConfig("textured", 2);
   config.frontend_lines = true;
+#ifdef PLDVO_SANITIZE
+  // CI budget under the sanitizers (docs/reliability.md): 8 frames instead of 15. Measured: 604
+  // correct, 38 wrong; edge gross fraction 2.95% -> 1.34%, edge mean NEES 20.30 -> 8.78.
+  config.num_frames = 8;
+#endif
   const MapEvalResult with_wrong = Evaluate(config);
   config.drop_wrong_matches = true;
   const MapEvalResult oracle = Evaluate(config);
   EXPECT_EQ(oracle.matches_wrong, with_wrong.matches_wrong);
   ASSERT_GT(with_wrong.matches_correct, 500);
-  EXPECT_GT(with_wrong.matches_wrong, 0.05 * with_wrong.matches_correct);
+  EXPECT_GT(with_wrong.matches_wrong, 0.04 * with_wrong.matches_correct);
   ASSERT_GT(oracle.line_guided.edges.count, 2000);
   EXPECT_GT(with_wrong.line_guided.edges.gross_fraction, 0.02);
   EXPECT_LT(oracle.line_guided.edges.gross_fraction,
-            0.5 * with_wrong.line_guided.edges.gross_fraction);
-  EXPECT_LT(oracle.line_guided.edges.mean_nees, 0.5 * with_wrong.line_guided.edges.mean_nees);
+            0.6 * with_wrong.line_guided.edges.gross_fraction);
+  EXPECT_LT(oracle.line_guided.edges.mean_nees, 0.6 * with_wrong.line_guided.edges.mean_nees);
   // The photometric run does not use the matches.
   EXPECT_EQ(oracle.photometric.edges.median_rel_error,
             with_wrong.photometric.edges.median_rel_error);
