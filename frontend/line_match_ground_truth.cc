@@ -39,6 +39,15 @@ bool TransferPixelByDepth(const PinholeCamera& camera, const cv::Mat& ref_depth,
   return true;
 }
 
+SegmentPredictor PredictorFromDepth(const PinholeCamera& camera, const cv::Mat& ref_depth,
+                                    const SE3& cur_from_ref, int window_radius_px) {
+  return [=](const LineSegment& s, Eigen::Vector2d* start, Eigen::Vector2d* end) {
+    return TransferPixelByDepth(camera, ref_depth, cur_from_ref, s.start, window_radius_px,
+                                start) &&
+           TransferPixelByDepth(camera, ref_depth, cur_from_ref, s.end, window_radius_px, end);
+  };
+}
+
 LineMatchTruth JudgeLineMatchByDepth(const PinholeCamera& camera, const LineSegment& ref,
                                      const cv::Mat& ref_depth, const SE3& cur_from_ref,
                                      const LineSegment& cur, const LineMatchTruthOptions& options) {

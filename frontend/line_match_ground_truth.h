@@ -18,6 +18,7 @@
 
 #include "core/pinhole_camera.h"
 #include "core/se3.h"
+#include "frontend/line_matcher.h"
 #include "frontend/line_segment.h"
 
 namespace pldvo {
@@ -40,6 +41,10 @@ struct LineMatchTruthOptions {
 bool TransferPixelByDepth(const PinholeCamera& camera, const cv::Mat& ref_depth,
                           const SE3& cur_from_ref, const Eigen::Vector2d& pixel_in_ref,
                           int window_radius_px, Eigen::Vector2d* pixel_in_cur);
+
+// The matcher's prediction from the true pose: both endpoints moved by TransferPixelByDepth.
+SegmentPredictor PredictorFromDepth(const PinholeCamera& camera, const cv::Mat& ref_depth,
+                                    const SE3& cur_from_ref, int window_radius_px = 2);
 
 LineMatchTruth JudgeLineMatchByDepth(const PinholeCamera& camera, const LineSegment& ref,
                                      const cv::Mat& ref_depth, const SE3& cur_from_ref,

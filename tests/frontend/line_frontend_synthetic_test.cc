@@ -269,12 +269,7 @@ TEST_F(LineFrontendSynthetic, MatchPrecisionRecallWithPredictedPosition) {
         const FrameData& ref = scene.frames.at(keyframe);
         const SE3 cur_from_ref =
             scene.frames.at(keyframe + gap).world_from_cam.Inverse() * ref.world_from_cam;
-        const PinholeCamera camera = scene.sequence.camera;
-        const cv::Mat depth = ref.rendered.depth;
-        return [=](const LineSegment& s, Eigen::Vector2d* start, Eigen::Vector2d* end) {
-          return TransferPixelByDepth(camera, depth, cur_from_ref, s.start, 2, start) &&
-                 TransferPixelByDepth(camera, depth, cur_from_ref, s.end, 2, end);
-        };
+        return PredictorFromDepth(scene.sequence.camera, ref.rendered.depth, cur_from_ref);
       },
       "predicted");
 }

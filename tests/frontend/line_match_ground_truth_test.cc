@@ -132,13 +132,8 @@ void ForEachMatch(const Clip& clip, bool predicted, Visit visit) {
                                clip.sequence.ground_truth[keyframe].world_from_cam;
       const PinholeCamera& camera = clip.sequence.camera;
       const cv::Mat& depth = clip.rendered.at(keyframe).depth;
-      SegmentPredictor predictor;
-      if (predicted) {
-        predictor = [&](const LineSegment& s, Eigen::Vector2d* start, Eigen::Vector2d* end) {
-          return TransferPixelByDepth(camera, depth, cur_from_ref, s.start, 2, start) &&
-                 TransferPixelByDepth(camera, depth, cur_from_ref, s.end, 2, end);
-        };
-      }
+      const SegmentPredictor predictor =
+          predicted ? PredictorFromDepth(camera, depth, cur_from_ref) : SegmentPredictor();
       for (const LineMatch& m : frontend.Match(ref, cur, predictor)) {
         const LineMatchTruth truth = JudgeLineMatchByDepth(camera, ref.segments[m.ref_index], depth,
                                                            cur_from_ref, cur.segments[m.cur_index]);
