@@ -2,14 +2,22 @@
 // (docs/tracking.md, "Convergence basin").
 //
 // Renders a synthetic sequence, picks frame pairs with gaps spread evenly from min_gap to
-// max_gap (reference frames spread over the sequence), builds the ground-truth reference of each
-// pair (GT depth; GT 3D edges projected with the GT poses as the line matches), tracks the later
-// frame from the identity pose with photometric_only, line_only and covariance (points and
-// lines) weighting, and counts a pair as converged when the estimate is within
-// translation_threshold and rotation_threshold of the ground truth. Prints a Markdown table per
-// gap bin.
+// max_gap (reference frames spread over the sequence), builds the reference of each pair from
+// its GT depth, tracks the later frame from the identity pose with photometric_only, line_only
+// and covariance (points and lines) weighting, and counts a pair as converged when the estimate
+// is within translation_threshold and rotation_threshold of the ground truth. Prints a Markdown
+// table per gap bin and the accuracy at gaps <= 10. The line matches (basin.lines):
+//   ground_truth  the scene's 3D edges projected with the GT poses (exact lines, points sampled
+//                 on the edges; the `reference` options);
+//   frontend      the odometry's: the line frontend's segments of both images matched without a
+//                 prediction, every keyframe segment traced, the mapping's semi-dense selection
+//                 with GT depth (DepthMapper::InitializeKeyframeFromDepth) and
+//                 mapping.max_reference_points per level (foot points with
+//                 mapping.edge_foot_points, as in MappingWorker); each match judged by
+//                 JudgeLineMatchByDepth, and with drop_wrong_matches the wrong ones left out.
 //   pldvo basin                                    # lowtex, 60 pairs, gaps 1..40, 320x240
 //   pldvo basin --set basin.preset=textured --set tracking.solver=ceres
+//   pldvo basin --set basin.lines=frontend [--set basin.drop_wrong_matches=true]
 #include <gflags/gflags.h>
 
 #include <algorithm>
@@ -23,11 +31,17 @@
 #include <string>
 #include <vector>
 
+#include "backend/depth_mapper.h"
+#include "backend/mapping_options.h"
+#include "backend/reference_builder.h"
 #include "backend/tracker.h"
 #include "core/config_io.h"
+#include "core/evaluation.h"
 #include "core/wall_clock.h"
 #include "experiments/command.h"
 #include "experiments/synthetic_pairs.h"
+#include "frontend/line_frontend.h"
+#include "frontend/line_match_ground_truth.h"
 
 DEFINE_string(basin_csv, "", "Optional CSV file with one row per pair and mode.");
 DEFINE_bool(basin_list_options, false, "Print every --set key with its default, then exit.");
@@ -46,6 +60,8 @@ struct BasinOptions {
   int max_gap = 40;
   double translation_threshold = 0.01;  // m
   double rotation_threshold = 0.5;      // deg
+  std::string lines = "ground_truth";
+  bool drop_wrong_matches = false;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
@@ -61,11 +77,20 @@ struct BasinOptions {
             "Converged when the translation error is below this (m)...");
     v.Field("rotation_threshold", &rotation_threshold,
             "...and the rotation error below this (deg).");
+    v.Field("lines", &lines,
+            "Line matches and reference: ground_truth (GT edges, exact lines) | frontend (the "
+            "line frontend's matches, the mapping's GT-depth keyframe map, as the odometry).");
+    v.Field("drop_wrong_matches", &drop_wrong_matches,
+            "frontend: leave out the matches the GT depth judges wrong (an oracle matcher).");
   }
   std::string Check() const {
     if (pairs < 1 || min_gap < 1 || max_gap < min_gap || frames <= max_gap + 1) {
       return "need pairs >= 1, 1 <= min_gap <= max_gap < frames - 1";
     }
+    if (lines != "ground_truth" && lines != "frontend") {
+      return "lines must be ground_truth or frontend, not '" + lines + "'";
+    }
+    if (drop_wrong_matches && lines != "frontend") return "drop_wrong_matches needs lines=frontend";
     return "";
   }
 };
@@ -74,19 +99,70 @@ struct BasinConfig {
   BasinOptions basin;
   TrackingOptions tracking;
   GroundTruthReferenceOptions reference;
+  LineFrontendOptions lines;
+  MappingOptions mapping;
   template <class Visitor>
   void VisitFields(Visitor& v) {
     v.Section("basin", &basin, "Pairs and convergence thresholds.");
     v.Section("tracking", &tracking, "Tracker options (the policy is set per mode).");
-    v.Section("reference", &reference, "Ground-truth reference construction.");
+    v.Section("reference", &reference,
+              "Reference construction (lines=frontend uses num_levels and idepth_var).");
+    v.Section("lines", &lines, "Line frontend (lines=frontend).");
+    v.Section("mapping", &mapping,
+              "Semi-dense selection and reference budget of the GT-depth map (lines=frontend).");
   }
   std::string Check() const {
     std::string error = basin.Check();
     if (error.empty()) error = tracking.Check();
     if (error.empty()) error = reference.Check();
+    if (error.empty()) error = lines.Check();
+    if (error.empty()) error = mapping.Check();
     return error;
   }
 };
+
+struct MatchCounts {
+  int correct = 0, wrong = 0, unverifiable = 0;
+};
+
+// basin.lines = frontend: the reference the odometry would track a pair against if its keyframe
+// map were the GT depth (header comment); counts the judged matches.
+TrackingReference FrontendPairReference(const synthetic_pairs::FramePair& pair,
+                                        const BasinConfig& config, LineFrontend* frontend,
+                                        MatchCounts* counts) {
+  const LineFrame keyframe = frontend->Process(pair.ref_image);
+  const LineFrame frame = frontend->Process(pair.cur_image);
+  std::vector<LineMatch> all(keyframe.segments.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i].ref_index = static_cast<int>(i);
+  const EdgeTrace edges = frontend->TraceMatched(keyframe, all);
+  std::vector<LineMatch> kept;
+  for (const LineMatch& m : frontend->Match(keyframe, frame)) {
+    const LineMatchTruth truth =
+        JudgeLineMatchByDepth(pair.camera, keyframe.segments[m.ref_index], pair.ref_depth,
+                              pair.cur_from_ref, frame.segments[m.cur_index]);
+    counts->correct += truth == LineMatchTruth::kCorrect;
+    counts->wrong += truth == LineMatchTruth::kWrong;
+    counts->unverifiable += truth == LineMatchTruth::kUnverifiable;
+    if (!config.basin.drop_wrong_matches || truth != LineMatchTruth::kWrong) kept.push_back(m);
+  }
+  DepthMapper mapper(pair.camera, config.mapping);
+  mapper.InitializeKeyframeFromDepth(pair.ref_image, edges, pair.ref_depth,
+                                     config.reference.idepth_var);
+  TrackingReference reference = BuildReferencePoints(
+      mapper.depth_map(), ImagePyramid(pair.ref_image, config.reference.num_levels), pair.camera,
+      config.mapping.max_reference_points,
+      config.mapping.edge_foot_points ? mapper.keyframe_lines() : std::vector<Eigen::Vector3d>());
+  SetMatchedLines(
+      MatchedLinesFromMatches(kept, frame.segments, static_cast<int>(keyframe.segments.size())),
+      &reference);
+  return reference;
+}
+
+double Mean(const std::vector<double>& values) {
+  double sum = 0.0;
+  for (double v : values) sum += v;
+  return values.empty() ? 0.0 : sum / values.size();
+}
 
 struct Mode {
   const char* name;
@@ -134,7 +210,11 @@ int RunBasin(const CommandContext& context) {
       int gap;
       double gt_translation, gt_rotation;
       bool converged[kNumModes];
+      double translation_error[kNumModes], rotation_error[kNumModes];
     };
+    const bool frontend_lines = basin.lines == "frontend";
+    LineFrontend frontend(config.lines);
+    MatchCounts counts;
     std::vector<Row> rows;
     double milliseconds[kNumModes] = {0, 0, 0};
     for (int k = 0; k < basin.pairs; ++k) {
@@ -149,7 +229,9 @@ int RunBasin(const CommandContext& context) {
       const synthetic_pairs::FramePair pair =
           synthetic_pairs::MakeFramePair(sequence, ref, ref + gap);
       const TrackingReference reference =
-          synthetic_pairs::MakePairReference(pair, config.reference, /*with_edges=*/true);
+          frontend_lines
+              ? FrontendPairReference(pair, config, &frontend, &counts)
+              : synthetic_pairs::MakePairReference(pair, config.reference, /*with_edges=*/true);
       const ImagePyramid current(pair.cur_image, config.reference.num_levels);
       Row row;
       row.gap = gap;
@@ -166,6 +248,8 @@ int RunBasin(const CommandContext& context) {
             synthetic_pairs::RotationErrorDeg(result.cur_from_ref, pair.cur_from_ref);
         row.converged[m] =
             t_error < basin.translation_threshold && r_error < basin.rotation_threshold;
+        row.translation_error[m] = t_error;
+        row.rotation_error[m] = r_error;
         if (csv) {
           csv << ref << "," << ref + gap << "," << gap << "," << row.gt_translation << ","
               << row.gt_rotation << "," << kModes[m].name << "," << t_error << "," << r_error << ","
@@ -179,11 +263,17 @@ int RunBasin(const CommandContext& context) {
     std::fprintf(stderr, "\n");
 
     std::printf(
-        "Convergence basin: preset %s, seed %d, %dx%d, %d pairs, solver %s; converged = "
-        "error < %.3g m and < %.3g deg from GT, tracking from identity.\n\n",
+        "Convergence basin: preset %s, seed %d, %dx%d, %d pairs, solver %s, lines %s%s; "
+        "converged = error < %.3g m and < %.3g deg from GT, tracking from identity.\n",
         basin.preset.c_str(), basin.seed, basin.width, basin.height, basin.pairs,
         config.tracking.solver.type == SolverOptions::Type::kCeres ? "ceres" : "gauss_newton",
+        basin.lines.c_str(), basin.drop_wrong_matches ? " (wrong matches dropped)" : "",
         basin.translation_threshold, basin.rotation_threshold);
+    if (frontend_lines) {
+      std::printf("Matches judged by depth: %d correct, %d wrong, %d unverifiable.\n",
+                  counts.correct, counts.wrong, counts.unverifiable);
+    }
+    std::printf("\n");
     std::printf("| gap (frames) | pairs | mean GT motion | photometric | lines | points+lines |\n");
     std::printf("| --- | --- | --- | --- | --- | --- |\n");
     auto print_row = [&](const std::string& label, int lo, int hi) {
@@ -209,6 +299,24 @@ int RunBasin(const CommandContext& context) {
       print_row(std::to_string(bin.lo) + "-" + std::to_string(bin.hi), bin.lo, bin.hi);
     }
     print_row("all", 0, 1 << 30);
+
+    // Accuracy at the small gaps, over every pair (converged or not).
+    constexpr int kAccuracyMaxGap = 10;
+    std::printf(
+        "\nAccuracy over the pairs with gap <= %d, every pair: translation error mean / median "
+        "(mm), rotation error mean / median (deg):\n\n",
+        kAccuracyMaxGap);
+    std::printf("| mode | pairs | translation mm | rotation deg |\n| --- | --- | --- | --- |\n");
+    for (int m = 0; m < kNumModes; ++m) {
+      std::vector<double> translation, rotation;
+      for (const Row& row : rows) {
+        if (row.gap > kAccuracyMaxGap) continue;
+        translation.push_back(1000.0 * row.translation_error[m]);
+        rotation.push_back(row.rotation_error[m]);
+      }
+      std::printf("| %s | %zu | %.3f / %.3f | %.4f / %.4f |\n", kModes[m].name, translation.size(),
+                  Mean(translation), Median(translation), Mean(rotation), Median(rotation));
+    }
     std::printf("\nMean tracking time per pair:");
     for (int m = 0; m < kNumModes; ++m) {
       std::printf(" %s %.1f ms;", kModes[m].name, milliseconds[m] / basin.pairs);

@@ -2,6 +2,7 @@
 // synthetic sequence written in the TUM layout (320x240, 36 frames): every output file, the
 // survival of the trajectory across a corrupt frame mid-run, the ablation tables and plot, and
 // the rejection of an unknown config key. Runs use the deterministic single-thread mapping.
+// `pldvo basin` with the frontend's lines on a few small-gap pairs.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -455,6 +456,33 @@ TEST(AblateCommandTest, RepeatsRunEachPairWithItsOwnInitSeed) {
                       " --out " + out.string() + " --repeats 0",
                   log),
             2);
+}
+
+TEST(BasinCommandTest, FrontendLinesTrackSmallGapsToTheTruth) {
+  // The odometry's reference from GT depth with the real frontend's matches: at gaps 1-4 the
+  // photometric and the points-and-lines problems converge to the true pose from the identity
+  // (docs/tracking.md, "The frontend's lines from a correct map"), the matches are judged by
+  // depth, and the oracle needs basin.lines=frontend.
+  const fs::path csv = TestRoot() / "basin_frontend.csv";
+  const fs::path log = TestRoot() / "basin_frontend.log";
+  const std::string pairs =
+      "basin --set basin.lines=frontend --set basin.frames=60 --set basin.pairs=4 "
+      "--set basin.max_gap=4";
+  ASSERT_EQ(Pldvo(pairs + " --basin_csv " + csv.string(), log), 0) << Slurp(log);
+  const std::string output = Slurp(log);
+  EXPECT_NE(output.find("Matches judged by depth: "), std::string::npos) << output;
+  const std::vector<std::vector<std::string>> rows = CsvRows(csv);
+  ASSERT_EQ(rows.size(), 12u);  // 4 pairs x 3 modes
+  for (const std::vector<std::string>& row : rows) {
+    ASSERT_EQ(row.size(), 12u);
+    if (row[5] == "lines") continue;  // lines alone need not converge at these gaps
+    EXPECT_EQ(row[8], "1") << row[0] << " -> " << row[1] << " " << row[5];
+    EXPECT_LT(std::stod(row[6]), 0.005) << row[0] << " -> " << row[1] << " " << row[5];
+  }
+  EXPECT_EQ(Pldvo(pairs + " --set basin.drop_wrong_matches=true", log), 0) << Slurp(log);
+  EXPECT_EQ(Pldvo("basin --set basin.drop_wrong_matches=true", log), 1);
+  EXPECT_NE(Slurp(log).find("drop_wrong_matches needs lines=frontend"), std::string::npos)
+      << Slurp(log);
 }
 
 }  // namespace
