@@ -1,6 +1,7 @@
 #include "experiments/mapping_evaluation.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -101,6 +102,28 @@ std::vector<std::vector<MatchedLine>> GroundTruthLinesPerFrame(
   return lines;
 }
 
+// exact_current_lines: the keyframe segment `ref` in the current frame. Its points at 1/4 and
+// 3/4 of its length (away from endpoints that may touch a depth edge) are lifted with the depth
+// of their own pixel (TransferPixelByDepth, window 0: a window's nearest depth would move them
+// on a slanted plane) and moved by the GT pose; the segment through them keeps ref's extent and
+// gets Sigma_l for `octave`. False when a point does not transfer.
+bool ExactCurrentSegment(const PinholeCamera& camera, const cv::Mat& depth, const SE3& cur_from_ref,
+                         const LineSegment& ref, int octave, double endpoint_sigma_px,
+                         LineSegment* cur) {
+  Eigen::Vector2d quarter, three_quarters;
+  if (!TransferPixelByDepth(camera, depth, cur_from_ref, ref.start + 0.25 * (ref.end - ref.start),
+                            0, &quarter) ||
+      !TransferPixelByDepth(camera, depth, cur_from_ref, ref.start + 0.75 * (ref.end - ref.start),
+                            0, &three_quarters) ||
+      (three_quarters - quarter).norm() < 0.5) {
+    return false;
+  }
+  const Eigen::Vector2d half = 0.5 * (three_quarters - quarter);
+  *cur = MakeLineSegment(quarter - half, three_quarters + half, octave,
+                         endpoint_sigma_px * std::ldexp(1.0, octave));
+  return true;
+}
+
 // frontend_lines: every keyframe segment traced (as the odometry does), every frame's segments
 // matched to the keyframe's without a prediction; the edge statistics on the traced pixels within
 // 0.5 px of their segment that `continuous` keeps, against the depth image. Every match is judged
@@ -140,7 +163,21 @@ void FrontendLines(const MapEvalConfig& config, const Frame& keyframe,
       wrong_matches->back()[m.ref_index] = truth == LineMatchTruth::kWrong;
       if (!config.drop_wrong_matches || truth != LineMatchTruth::kWrong) kept.push_back(m);
     }
-    lines->push_back(MatchedLinesFromMatches(kept, frame_lines.segments,
+    std::vector<LineSegment> cur_segments = frame_lines.segments;
+    if (config.exact_current_lines) {
+      std::vector<LineMatch> transferred;
+      for (const LineMatch& m : kept) {
+        const LineSegment& ref = keyframe_lines.segments[m.ref_index];
+        if (!ExactCurrentSegment(
+                camera, keyframe.depth, cur_from_ref, ref, frame_lines.segments[m.cur_index].octave,
+                config.lines.detector.endpoint_sigma_px, &cur_segments[m.cur_index])) {
+          continue;
+        }
+        transferred.push_back(m);
+      }
+      kept = transferred;
+    }
+    lines->push_back(MatchedLinesFromMatches(kept, cur_segments,
                                              static_cast<int>(keyframe_lines.segments.size())));
   }
 }
@@ -178,6 +215,7 @@ std::string MapEvalConfig::Check() const {
     return "frontend_lines needs line_sigma_sweep=[] (the sweep perturbs GT lines)";
   }
   if (drop_wrong_matches && !frontend_lines) return "drop_wrong_matches needs frontend_lines";
+  if (exact_current_lines && !frontend_lines) return "exact_current_lines needs frontend_lines";
   if (frontend_lines && keyframe_line_sigma_px > 0.0) {
     return "keyframe_line_sigma_px perturbs GT lines, which frontend_lines does not use";
   }
@@ -231,6 +269,7 @@ MapEvalResult RunMapEvaluation(const MapEvalConfig& config,
   result.width = camera.width;
   result.height = camera.height;
   result.frontend_lines = config.frontend_lines;
+  result.exact_current_lines = config.exact_current_lines;
   for (const TracedLine& line : edges.trace.lines) {
     result.num_edges += !line.pixels.empty();
     result.num_edge_pixels += static_cast<int>(line.pixels.size());
@@ -311,6 +350,10 @@ std::string FormatMapEvalTable(const MapEvalResult& r) {
                   r.matches_correct, r.matches_wrong, r.matches_unverifiable,
                   r.matches_correct / std::max(1.0, 1.0 * (r.matches_correct + r.matches_wrong)));
     out << line;
+    if (r.exact_current_lines) {
+      out << "current lines: the keyframe segments moved with the GT depth and poses "
+             "(exact_current_lines)\n";
+    }
   }
   out << "| stereo | line sigma px | hyp. | rel. err | mean NEES | median NEES | in 2 sigma | "
          "edge px | edge rel. err | edge mean NEES | edge median NEES | edge rel. err after 3D "

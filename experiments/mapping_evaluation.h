@@ -39,6 +39,11 @@ struct MapEvalConfig {
   // frontend_lines only: leave out the matches that the depth image and the GT pose call wrong
   // (JudgeLineMatchByDepth): the line-guided stereo with an oracle matcher.
   bool drop_wrong_matches = false;
+  // frontend_lines only: each kept match's current segment replaced by its keyframe segment moved
+  // with the depth image and the GT pose (ExactCurrentSegment; Sigma_l as the detected segment's
+  // octave gives), matches that do not transfer left out: the current frame's detection error
+  // removed, the keyframe segment's kept.
+  bool exact_current_lines = false;
   LineFrontendOptions lines;
   // Best of this many timings of the edge stereo with wide priors (0 skips the timing).
   int speed_repetitions = 5;
@@ -77,6 +82,9 @@ struct MapEvalConfig {
             "line_sigma_sweep=[]).");
     v.Field("drop_wrong_matches", &drop_wrong_matches,
             "frontend_lines: leave out the matches the GT depth and pose call wrong (oracle).");
+    v.Field("exact_current_lines", &exact_current_lines,
+            "frontend_lines: the current lines are the keyframe segments moved with the GT depth "
+            "and pose (no current detection error).");
     v.Section("synth", &synth, "Synthetic sequence.");
     v.Section("mapping", &mapping, "Mapping options.");
     v.Section("lines", &lines, "Line frontend (frontend_lines only).");
@@ -102,7 +110,8 @@ struct MapEvalRun {
 };
 
 struct MapEvalResult {
-  bool frontend_lines = false;  // the edges below are the frontend's (else the GT edges)
+  bool frontend_lines = false;       // the edges below are the frontend's (else the GT edges)
+  bool exact_current_lines = false;  // config.exact_current_lines
   // frontend_lines: the frontend's matches over all frames, judged by JudgeLineMatchByDepth
   // (before drop_wrong_matches).
   int matches_correct = 0, matches_wrong = 0, matches_unverifiable = 0;
