@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "core/wall_clock.h"
+#include "frontend/line_refiner.h"
 
 namespace pldvo {
 namespace {
@@ -38,6 +39,10 @@ LineFrame LineFrontend::Process(const cv::Mat& image) {
 
   start = WallClock::now();
   frame.segments = merger_.Merge(detected);
+  if (options_.refiner.enabled) {
+    RefineSegmentsToEdges(gray, options_.refiner, options_.detector.endpoint_sigma_px,
+                          &frame.segments);
+  }
   frame.timing.merging_ms = MsSince(start);
   frame.timing.num_lines = static_cast<int>(frame.segments.size());
 

@@ -23,7 +23,7 @@ namespace pldvo {
 // Wall-clock milliseconds per component of one frame.
 struct LineFrontendTiming {
   double detection_ms = 0.0;    // 8-bit conversion, octave pyramid and detection
-  double merging_ms = 0.0;      // merging and the length filter
+  double merging_ms = 0.0;      // merging, the length filter and the refit (lines.refiner)
   double description_ms = 0.0;  // LBD
   double matching_ms = 0.0;     // keyframe -> frame matching
   double tracing_ms = 0.0;      // edge tracing (keyframes only)

@@ -35,6 +35,18 @@ std::string LineMergerOptions::Check() const {
   return "";
 }
 
+std::string LineRefinerOptions::Check() const {
+  if (!(sample_step_px >= 0.5)) return "refiner.sample_step_px must be >= 0.5";
+  if (search_radius_px < 1 || search_radius_px > 8) return "refiner.search_radius_px in 1..8";
+  if (!(min_edge_step > 0.0)) return "refiner.min_edge_step must be > 0";
+  if (!(min_point_fraction >= 0.0 && min_point_fraction <= 1.0)) {
+    return "refiner.min_point_fraction must be in [0, 1]";
+  }
+  if (!(max_angle_deg >= 0.0)) return "refiner.max_angle_deg must be >= 0";
+  if (!(max_shift_px >= 0.0)) return "refiner.max_shift_px must be >= 0";
+  return "";
+}
+
 std::string LineDescriptorOptions::Check() const {
   if (band_width < 1 || band_width > 20) return "descriptor.band_width must be in 1..20";
   if (min_octave < 0 || min_octave > 4) return "descriptor.min_octave must be in 0..4";
@@ -65,8 +77,8 @@ std::string EdgeTracerOptions::Check() const {
 }
 
 std::string LineFrontendOptions::Check() const {
-  for (const std::string& error :
-       {detector.Check(), merger.Check(), descriptor.Check(), matcher.Check(), tracer.Check()}) {
+  for (const std::string& error : {detector.Check(), merger.Check(), refiner.Check(),
+                                   descriptor.Check(), matcher.Check(), tracer.Check()}) {
     if (!error.empty()) return error;
   }
   return "";

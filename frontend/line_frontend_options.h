@@ -204,9 +204,39 @@ struct EdgeTracerOptions {
   std::string Check() const;
 };
 
+// Sub-pixel refit of the merged segments to the image's edge (frontend/line_refiner.h).
+struct LineRefinerOptions {
+  bool enabled = false;
+  double sample_step_px = 2.0;  // spacing of the cross-profiles along the segment
+  int search_radius_px = 2;     // profile half-length across the segment, pixels (1..8)
+  double min_edge_step = 5.0;   // gray levels across one pixel at the edge point
+  double min_point_fraction = 0.5;
+  double max_angle_deg = 2.0;
+  double max_shift_px = 1.5;
+
+  template <class Visitor>
+  void VisitFields(Visitor& v) {
+    v.Field("enabled", &enabled,
+            "Refit each merged segment to the sub-pixel gradient maxima across it (default "
+            "false).");
+    v.Field("sample_step_px", &sample_step_px, "Spacing of the cross-profiles (px).");
+    v.Field("search_radius_px", &search_radius_px,
+            "Half-length of a cross-profile (px, 1..8): how far off the edge may lie.");
+    v.Field("min_edge_step", &min_edge_step,
+            "Smallest intensity step across one pixel that counts as the edge (gray levels).");
+    v.Field("min_point_fraction", &min_point_fraction,
+            "Keep the segment unless this fraction of its profiles find the edge.");
+    v.Field("max_angle_deg", &max_angle_deg, "Keep the segment when the refit turns it more.");
+    v.Field("max_shift_px", &max_shift_px,
+            "Keep the segment when the refit moves its midpoint more (px).");
+  }
+  std::string Check() const;
+};
+
 struct LineFrontendOptions {
   LineDetectorOptions detector;
   LineMergerOptions merger;
+  LineRefinerOptions refiner;
   LineDescriptorOptions descriptor;
   LineMatcherOptions matcher;
   EdgeTracerOptions tracer;
@@ -215,6 +245,7 @@ struct LineFrontendOptions {
   void VisitFields(Visitor& v) {
     v.Section("detector", &detector, "Line segment detection.");
     v.Section("merger", &merger, "Merging of broken segments.");
+    v.Section("refiner", &refiner, "Sub-pixel refit of the merged segments.");
     v.Section("descriptor", &descriptor, "LBD descriptors.");
     v.Section("matcher", &matcher, "Keyframe -> frame matching.");
     v.Section("tracer", &tracer, "Edge tracing of matched keyframe lines.");

@@ -245,13 +245,16 @@ void RegisterAll() {
   no_nfa.detector.edlines_nfa_validation = false;
   LineFrontendOptions short_support = defaults;
   short_support.descriptor.max_support_px = 32;
+  LineFrontendOptions refit = defaults;
+  refit.refiner.enabled = true;
   for (const auto& [name, options] :
        {std::pair<const char*, LineFrontendOptions>{"Textured/default", defaults},
         {"Textured/num_octaves:1", one_octave},
         {"Textured/descriptor_min_octave:2", coarse_lbd},
         {"Textured/max_segments:100", fewer_lines},
         {"Textured/edlines_nfa_validation:0", no_nfa},
-        {"Textured/descriptor_max_support:32", short_support}}) {
+        {"Textured/descriptor_max_support:32", short_support},
+        {"Textured/refiner:1", refit}}) {
     benchmark::RegisterBenchmark(name, BM_Textured, options)->Unit(benchmark::kMillisecond);
   }
   if (std::filesystem::is_directory(std::filesystem::path(kKittiDir) / "rgb")) {
