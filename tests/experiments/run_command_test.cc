@@ -479,7 +479,9 @@ TEST(BasinCommandTest, FrontendLinesTrackSmallGapsToTheTruth) {
     EXPECT_EQ(row[8], "1") << row[0] << " -> " << row[1] << " " << row[5];
     EXPECT_LT(std::stod(row[6]), 0.005) << row[0] << " -> " << row[1] << " " << row[5];
   }
-  EXPECT_EQ(Pldvo(pairs + " --set basin.drop_wrong_matches=true", log), 0) << Slurp(log);
+  // The oracle on one pair (it runs; the sanitizers' CI budget, docs/reliability.md).
+  EXPECT_EQ(Pldvo(pairs + " --set basin.pairs=1 --set basin.drop_wrong_matches=true", log), 0)
+      << Slurp(log);
   EXPECT_EQ(Pldvo("basin --set basin.drop_wrong_matches=true", log), 1);
   EXPECT_NE(Slurp(log).find("drop_wrong_matches needs lines=frontend"), std::string::npos)
       << Slurp(log);
