@@ -32,13 +32,21 @@ struct KeyframeEdges {
   cv::Mat mask;    // CV_8U: the evaluated edge pixels
 };
 
+// The final maps of a run, before and after the 3D line regularisation.
+struct VariantMaps {
+  SemiDenseDepthMap raw;
+  SemiDenseDepthMap line_regularized;
+};
+
 // lines[k]: the matched lines of frames[k], indexed by keyframe edge id; wrong_matches[k][e]
-// (frontend_lines, else empty): JudgeLineMatchByDepth called that match wrong.
+// (frontend_lines, else empty): JudgeLineMatchByDepth called that match wrong. `maps` (optional)
+// receives the run's final maps.
 MapEvalRun RunVariant(const MapEvalConfig& config, bool line_stereo, double line_sigma_px,
                       const PinholeCamera& camera, const Frame& keyframe,
                       const std::vector<Frame>& frames, const KeyframeEdges& edges,
                       const std::vector<std::vector<MatchedLine>>& lines,
-                      const std::vector<std::vector<char>>& wrong_matches = {}) {
+                      const std::vector<std::vector<char>>& wrong_matches = {},
+                      VariantMaps* maps = nullptr) {
   MappingOptions options = config.mapping;
   options.use_line_stereo = line_stereo;
   DepthMapper mapper(camera, options);
@@ -86,7 +94,21 @@ MapEvalRun RunVariant(const MapEvalConfig& config, bool line_stereo, double line
   const SemiDenseDepthMap line_regularized = mapper.RegularizedMap(false, true, &run.line_stats);
   run.edges_line_regularized = EvaluateDepthMap(line_regularized, edges.idepth, edges.mask);
   run.all_smoothed = EvaluateDepthMap(mapper.RegularizedMap(true, false), gt_idepth, cv::Mat());
+  if (maps != nullptr) *maps = {map, line_regularized};
   return run;
+}
+
+// The evaluated edge pixels that both runs observed: the two stereo methods on the same pixels.
+cv::Mat CommonEdgeMask(const cv::Mat& edge_mask, const SemiDenseDepthMap& a,
+                       const SemiDenseDepthMap& b) {
+  cv::Mat common = edge_mask.clone();
+  for (int y = 0; y < common.rows; ++y) {
+    for (int x = 0; x < common.cols; ++x) {
+      const int i = a.Index(x, y);
+      if (!a.observed(i) || !b.observed(i)) common.at<uint8_t>(y, x) = 0;
+    }
+  }
+  return common;
 }
 
 // The GT lines of every frame at endpoint noise sigma_px (frame k seeded line_seed + k).
@@ -276,9 +298,18 @@ MapEvalResult RunMapEvaluation(const MapEvalConfig& config,
   }
   result.baseline_m =
       (frames.back().world_from_cam.translation() - keyframe.world_from_cam.translation()).norm();
-  result.photometric = RunVariant(config, false, 0.0, camera, keyframe, frames, edges, lines);
+  VariantMaps photometric_maps, line_maps;
+  result.photometric =
+      RunVariant(config, false, 0.0, camera, keyframe, frames, edges, lines, {}, &photometric_maps);
   result.line_guided = RunVariant(config, true, config.line_sigma_px, camera, keyframe, frames,
-                                  edges, lines, wrong_matches);
+                                  edges, lines, wrong_matches, &line_maps);
+  const cv::Mat common = CommonEdgeMask(edges.mask, photometric_maps.raw, line_maps.raw);
+  result.common_edges_photometric = EvaluateDepthMap(photometric_maps.raw, edges.idepth, common);
+  result.common_edges_line = EvaluateDepthMap(line_maps.raw, edges.idepth, common);
+  result.common_edges_photometric_line_regularized =
+      EvaluateDepthMap(photometric_maps.line_regularized, edges.idepth, common);
+  result.common_edges_line_line_regularized =
+      EvaluateDepthMap(line_maps.line_regularized, edges.idepth, common);
   for (double sigma : config.line_sigma_sweep) {
     if (sigma < 0.0) throw std::invalid_argument("MapEvalConfig: line_sigma_sweep must be >= 0");
     result.line_sweep.push_back(
@@ -415,6 +446,15 @@ std::string FormatMapEvalTable(const MapEvalResult& r) {
                   run.line_stats.pixels_updated, run.line_stats.pixels_rejected);
     out << line;
   }
+  std::snprintf(line, sizeof(line),
+                "edge pixels observed by both runs: %d; rel. err photometric %.4f, line-guided "
+                "%.4f (mean NEES %.2f, %.2f); after 3D line reg. %.4f, %.4f\n",
+                r.common_edges_photometric.count, r.common_edges_photometric.median_rel_error,
+                r.common_edges_line.median_rel_error, r.common_edges_photometric.mean_nees,
+                r.common_edges_line.mean_nees,
+                r.common_edges_photometric_line_regularized.median_rel_error,
+                r.common_edges_line_line_regularized.median_rel_error);
+  out << line;
   if (r.wide_prior_photometric_us > 0.0) {
     std::snprintf(line, sizeof(line),
                   "edge stereo with wide priors (random init vs the last frame): photometric SSD "

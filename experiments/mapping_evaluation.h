@@ -120,6 +120,11 @@ struct MapEvalResult {
   MapEvalRun photometric;
   MapEvalRun line_guided;              // at config.line_sigma_px
   std::vector<MapEvalRun> line_sweep;  // at config.line_sigma_sweep
+  // The edge pixels both runs observed (each run's `edges` are its own observed pixels, and the
+  // line-guided run observes pixels the SSD search does not): the two methods on the same pixels,
+  // raw and after the 3D line regularisation.
+  DepthErrorStats common_edges_photometric, common_edges_line;
+  DepthErrorStats common_edges_photometric_line_regularized, common_edges_line_line_regularized;
   // Edge-pixel stereo time from the random initialisation against the last frame (wide priors,
   // one update; min over config.speed_repetitions, 0 when skipped), microseconds per edge pixel.
   double wide_prior_photometric_us = 0.0;
