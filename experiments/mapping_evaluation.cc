@@ -170,6 +170,7 @@ void FrontendLines(const MapEvalConfig& config, const Frame& keyframe,
       }
     }
   }
+  std::vector<double> offsets;
   for (const Frame& frame : frames) {
     const LineFrame frame_lines = frontend.Process(frame.image);
     const SE3 cur_from_ref = frame.world_from_cam.Inverse() * keyframe.world_from_cam;
@@ -184,6 +185,19 @@ void FrontendLines(const MapEvalConfig& config, const Frame& keyframe,
       result->matches_unverifiable += truth == LineMatchTruth::kUnverifiable;
       wrong_matches->back()[m.ref_index] = truth == LineMatchTruth::kWrong;
       if (!config.drop_wrong_matches || truth != LineMatchTruth::kWrong) kept.push_back(m);
+      // The detection error of a correct match's current segment: its line's distance from the
+      // points at 1/4 and 3/4 of the exact segment (the points ExactCurrentSegment transfers).
+      LineSegment exact;
+      const LineSegment& detected = frame_lines.segments[m.cur_index];
+      if (truth == LineMatchTruth::kCorrect &&
+          ExactCurrentSegment(camera, keyframe.depth, cur_from_ref,
+                              keyframe_lines.segments[m.ref_index], detected.octave,
+                              config.lines.detector.endpoint_sigma_px, &exact)) {
+        for (const double f : {0.25, 0.75}) {
+          offsets.push_back(
+              std::abs(detected.SignedDistance(exact.start + f * (exact.end - exact.start))));
+        }
+      }
     }
     std::vector<LineSegment> cur_segments = frame_lines.segments;
     if (config.exact_current_lines) {
@@ -201,6 +215,12 @@ void FrontendLines(const MapEvalConfig& config, const Frame& keyframe,
     }
     lines->push_back(MatchedLinesFromMatches(kept, cur_segments,
                                              static_cast<int>(keyframe_lines.segments.size())));
+  }
+  result->current_offset_count = static_cast<int>(offsets.size());
+  if (!offsets.empty()) {
+    std::sort(offsets.begin(), offsets.end());
+    result->current_offset_median_px = offsets[offsets.size() / 2];
+    result->current_offset_p90_px = offsets[offsets.size() * 9 / 10];
   }
 }
 
@@ -380,6 +400,11 @@ std::string FormatMapEvalTable(const MapEvalResult& r) {
                   "unverifiable (precision %.3f)\n",
                   r.matches_correct, r.matches_wrong, r.matches_unverifiable,
                   r.matches_correct / std::max(1.0, 1.0 * (r.matches_correct + r.matches_wrong)));
+    out << line;
+    std::snprintf(line, sizeof(line),
+                  "current segments of the correct matches to their exact position (%d points at "
+                  "1/4 and 3/4): median %.3f px, 90th percentile %.3f px\n",
+                  r.current_offset_count, r.current_offset_median_px, r.current_offset_p90_px);
     out << line;
     if (r.exact_current_lines) {
       out << "current lines: the keyframe segments moved with the GT depth and poses "

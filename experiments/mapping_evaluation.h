@@ -115,6 +115,10 @@ struct MapEvalResult {
   // frontend_lines: the frontend's matches over all frames, judged by JudgeLineMatchByDepth
   // (before drop_wrong_matches).
   int matches_correct = 0, matches_wrong = 0, matches_unverifiable = 0;
+  // frontend_lines: the correct matches' current segments against ExactCurrentSegment (the
+  // detection error): distance of the detected line from the exact points at 1/4 and 3/4.
+  int current_offset_count = 0;
+  double current_offset_median_px = 0.0, current_offset_p90_px = 0.0;
   int width = 0, height = 0, num_edges = 0, num_edge_pixels = 0;
   double baseline_m = 0.0;  // keyframe-to-last-frame distance
   MapEvalRun photometric;
