@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -32,24 +33,25 @@ struct KeyframeEdges {
   cv::Mat mask;    // CV_8U: the evaluated edge pixels
 };
 
-// The final maps of a run, before and after the 3D line regularisation.
-struct VariantMaps {
-  SemiDenseDepthMap raw;
+// The state a run ends in: its mapper and the map after the 3D line regularisation.
+struct VariantState {
+  std::unique_ptr<DepthMapper> mapper;
   SemiDenseDepthMap line_regularized;
 };
 
 // lines[k]: the matched lines of frames[k], indexed by keyframe edge id; wrong_matches[k][e]
-// (frontend_lines, else empty): JudgeLineMatchByDepth called that match wrong. `maps` (optional)
-// receives the run's final maps.
+// (frontend_lines, else empty): JudgeLineMatchByDepth called that match wrong. `state`
+// (optional) receives the run's final state.
 MapEvalRun RunVariant(const MapEvalConfig& config, bool line_stereo, double line_sigma_px,
                       const PinholeCamera& camera, const Frame& keyframe,
                       const std::vector<Frame>& frames, const KeyframeEdges& edges,
                       const std::vector<std::vector<MatchedLine>>& lines,
                       const std::vector<std::vector<char>>& wrong_matches = {},
-                      VariantMaps* maps = nullptr) {
+                      VariantState* state = nullptr) {
   MappingOptions options = config.mapping;
   options.use_line_stereo = line_stereo;
-  DepthMapper mapper(camera, options);
+  auto owned_mapper = std::make_unique<DepthMapper>(camera, options);
+  DepthMapper& mapper = *owned_mapper;
   mapper.InitializeKeyframe(keyframe.image, edges.trace);
   MapEvalRun run;
   run.line_sigma_px = line_sigma_px;
@@ -94,7 +96,7 @@ MapEvalRun RunVariant(const MapEvalConfig& config, bool line_stereo, double line
   const SemiDenseDepthMap line_regularized = mapper.RegularizedMap(false, true, &run.line_stats);
   run.edges_line_regularized = EvaluateDepthMap(line_regularized, edges.idepth, edges.mask);
   run.all_smoothed = EvaluateDepthMap(mapper.RegularizedMap(true, false), gt_idepth, cv::Mat());
-  if (maps != nullptr) *maps = {map, line_regularized};
+  if (state != nullptr) *state = {std::move(owned_mapper), line_regularized};
   return run;
 }
 
@@ -318,18 +320,20 @@ MapEvalResult RunMapEvaluation(const MapEvalConfig& config,
   }
   result.baseline_m =
       (frames.back().world_from_cam.translation() - keyframe.world_from_cam.translation()).norm();
-  VariantMaps photometric_maps, line_maps;
-  result.photometric =
-      RunVariant(config, false, 0.0, camera, keyframe, frames, edges, lines, {}, &photometric_maps);
+  VariantState photometric_state, line_state;
+  result.photometric = RunVariant(config, false, 0.0, camera, keyframe, frames, edges, lines, {},
+                                  &photometric_state);
   result.line_guided = RunVariant(config, true, config.line_sigma_px, camera, keyframe, frames,
-                                  edges, lines, wrong_matches, &line_maps);
-  const cv::Mat common = CommonEdgeMask(edges.mask, photometric_maps.raw, line_maps.raw);
-  result.common_edges_photometric = EvaluateDepthMap(photometric_maps.raw, edges.idepth, common);
-  result.common_edges_line = EvaluateDepthMap(line_maps.raw, edges.idepth, common);
+                                  edges, lines, wrong_matches, &line_state);
+  const SemiDenseDepthMap& photometric_map = photometric_state.mapper->depth_map();
+  const SemiDenseDepthMap& line_map = line_state.mapper->depth_map();
+  const cv::Mat common = CommonEdgeMask(edges.mask, photometric_map, line_map);
+  result.common_edges_photometric = EvaluateDepthMap(photometric_map, edges.idepth, common);
+  result.common_edges_line = EvaluateDepthMap(line_map, edges.idepth, common);
   result.common_edges_photometric_line_regularized =
-      EvaluateDepthMap(photometric_maps.line_regularized, edges.idepth, common);
+      EvaluateDepthMap(photometric_state.line_regularized, edges.idepth, common);
   result.common_edges_line_line_regularized =
-      EvaluateDepthMap(line_maps.line_regularized, edges.idepth, common);
+      EvaluateDepthMap(line_state.line_regularized, edges.idepth, common);
   for (double sigma : config.line_sigma_sweep) {
     if (sigma < 0.0) throw std::invalid_argument("MapEvalConfig: line_sigma_sweep must be >= 0");
     result.line_sweep.push_back(
@@ -357,13 +361,10 @@ MapEvalResult RunMapEvaluation(const MapEvalConfig& config,
       (variant == 0 ? result.wide_prior_photometric_us : result.wide_prior_line_us) = best;
     }
   }
-  // Propagation of the line-guided map to the last frame.
-  DepthMapper mapper(camera, config.mapping);
-  mapper.InitializeKeyframe(keyframe.image, edges.trace);
-  for (size_t k = 0; k < frames.size(); ++k) {
-    mapper.UpdateWithFrame(frames[k].image,
-                           frames[k].world_from_cam.Inverse() * keyframe.world_from_cam, lines[k]);
-  }
+  // The written maps and the propagation to the last frame: those of the run whose options are
+  // config.mapping's (the line-guided one unless mapping.use_line_stereo is false).
+  DepthMapper& mapper =
+      config.mapping.use_line_stereo ? *line_state.mapper : *photometric_state.mapper;
   if (!config.out_dir.empty()) {
     std::filesystem::create_directories(config.out_dir);
     WriteInverseDepthPng(mapper.depth_map(), config.out_dir + "/keyframe_idepth.png");
