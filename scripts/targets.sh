@@ -17,13 +17,14 @@
 # on a quiet 2-core machine (the grid 20 of them). Each step's own tables stay in OUT (results.md
 # of every ablation).
 set -euo pipefail
+# OUT and PLDVO_KITTI are relative to the caller's folder; the default KITTI folder is ../shared.
+out=$(realpath -m "${1:-/tmp/pldvo_targets}")
+kitti=$(realpath -m "${PLDVO_KITTI:-$(dirname "$0")/../../shared/data/kitti00_first200}")
 cd "$(dirname "$0")/.."
 scripts/build.sh >/dev/null
 build=${PLDVO_BUILD_DIR:-build}
 pldvo="$build/experiments/pldvo"
 configs=experiments/configs
-out=${1:-/tmp/pldvo_targets}
-kitti=${PLDVO_KITTI:-../shared/data/kitti00_first200}
 jobs=$(nproc)
 mkdir -p "$out/seq"
 
