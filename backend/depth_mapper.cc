@@ -202,7 +202,8 @@ void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
 }
 
 FrameUpdateStats DepthMapper::UpdateWithFrame(const cv::Mat& image, const SE3& cur_from_ref,
-                                              const std::vector<MatchedLine>& lines_in_cur) {
+                                              const std::vector<MatchedLine>& lines_in_cur,
+                                              const Matrix6d& pose_covariance) {
   if (image.empty() || image.cols != map_.width() || image.rows != map_.height() ||
       image.channels() != 1) {
     throw std::invalid_argument(
@@ -210,7 +211,7 @@ FrameUpdateStats DepthMapper::UpdateWithFrame(const cv::Mat& image, const SE3& c
   }
   FrameUpdateStats stats;
   const ImagePyramid current(image, 1);
-  const EpipolarGeometry geometry(camera_, cur_from_ref);
+  const EpipolarGeometry geometry(camera_, cur_from_ref, pose_covariance);
   if (!(cur_from_ref.translation().norm() > 0.0)) return stats;  // no baseline, no stereo
   // Matches whose line most of the edge's hypotheses contradict are left out for this frame; the
   // edge's pixels then search like pixels without a line.

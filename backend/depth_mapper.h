@@ -87,9 +87,12 @@ class DepthMapper {
 
   // Stereo with a tracked frame and fusion. lines_in_cur[e] is the current line matched to the
   // keyframe edge e (the id in the keyframe's EdgeTrace); missing or unmatched entries use the
-  // SSD search.
+  // SSD search. `pose_covariance`: the tracked pose's error (tracking.pose_covariance), added
+  // to the epipolar line's position error of every stereo observation; zero: the constant
+  // mapping.sigma_epipolar_px alone.
   FrameUpdateStats UpdateWithFrame(const cv::Mat& image, const SE3& cur_from_ref,
-                                   const std::vector<MatchedLine>& lines_in_cur);
+                                   const std::vector<MatchedLine>& lines_in_cur,
+                                   const Matrix6d& pose_covariance = Matrix6d::Zero());
 
   // Fuses the edge BA's optimised 3D lines (keyframe frame, with tangent covariances;
   // edge_ba_line_depth.h): every valid pixel whose edge id has a line gets the inverse depth of

@@ -13,8 +13,12 @@ constexpr double kMinZ = 1e-6;
 
 }  // namespace
 
-EpipolarGeometry::EpipolarGeometry(const PinholeCamera& camera, const SE3& cur_from_ref)
-    : camera_(camera), cur_from_ref_(cur_from_ref) {
+EpipolarGeometry::EpipolarGeometry(const PinholeCamera& camera, const SE3& cur_from_ref,
+                                   const Matrix6d& pose_covariance)
+    : camera_(camera),
+      cur_from_ref_(cur_from_ref),
+      pose_covariance_(pose_covariance),
+      has_pose_covariance_(!pose_covariance.isZero(0.0)) {
   const Eigen::Matrix3d k = camera.K();
   krki_ = k * cur_from_ref.rotation_matrix() * k.inverse();
   kt_ = k * cur_from_ref.translation();
@@ -55,6 +59,19 @@ bool EpipolarGeometry::EpipolarDirectionInRef(const Eigen::Vector2d& pixel_in_re
   if (!(norm > 1e-9 * (1.0 + epipole_in_ref_h_.norm()))) return false;
   *dir = d / norm;
   return true;
+}
+
+double EpipolarGeometry::PoseOffsetVar(const Eigen::Vector2d& pixel_in_ref, double idepth,
+                                       const Eigen::Vector2d& normal_in_cur) const {
+  if (!has_pose_covariance_) return 0.0;
+  const Eigen::Vector3d y = cur_from_ref_.rotation_matrix() * camera_.Unproject(pixel_in_ref) +
+                            idepth * cur_from_ref_.translation();
+  const Eigen::RowVector3d n_dpi = normal_in_cur.transpose() * camera_.ProjectJacobian(y);
+  // dY / d(t; w) = [d I, -[Y]x], and n_dpi (-[Y]x) w = w . (Y x n_dpi).
+  Eigen::Matrix<double, 1, 6> row;
+  row.head<3>() = idepth * n_dpi;
+  row.tail<3>() = y.cross(n_dpi.transpose()).transpose();
+  return row * pose_covariance_ * row.transpose();
 }
 
 const char* StereoStatusName(StereoStatus status) {
@@ -131,9 +148,9 @@ double PatchSsd(const ImagePyramid& current, const EpipolarPatch& patch,
   return ssd;
 }
 
-double GeometricDisparityVar(const EpipolarPatch& patch, double sigma_epipolar_px) {
+double GeometricDisparityVar(const EpipolarPatch& patch, double epipolar_position_var) {
   const double c = std::max(patch.gradient_epipolar_cos, 1e-6);
-  return sigma_epipolar_px * sigma_epipolar_px / (c * c);
+  return epipolar_position_var / (c * c);
 }
 
 double PhotometricDisparityVar(const ImagePyramid& current, const EpipolarPatch& patch,
@@ -176,6 +193,7 @@ StereoStatus SearchEpipolarSsd(const ImagePyramid& current, const EpipolarGeomet
   } else {
     direction = patch.step_cur.normalized();
   }
+  const Eigen::Vector2d normal(-direction.y(), direction.x());
   Eigen::Vector2d start = p_far;
   if (length < options.min_search_length_px) {
     start = 0.5 * (p_far + p_near) - 0.5 * options.min_search_length_px * direction;
@@ -246,7 +264,11 @@ StereoStatus SearchEpipolarSsd(const ImagePyramid& current, const EpipolarGeomet
       options.residual_intensity_noise
           ? std::max(options.sigma_intensity, std::sqrt(residual_ssd / 8.0))
           : options.sigma_intensity;
-  const double disparity_var = GeometricDisparityVar(patch, options.sigma_epipolar_px) +
+  // The epipolar line's position error: the constant sigma_epipolar_px plus, with a tracked
+  // pose covariance, its propagation to this point (EpipolarGeometry::PoseOffsetVar).
+  const double epipolar_var = options.sigma_epipolar_px * options.sigma_epipolar_px +
+                              geometry.PoseOffsetVar(pixel_in_ref, idepth, normal);
+  const double disparity_var = GeometricDisparityVar(patch, epipolar_var) +
                                PhotometricDisparityVar(current, patch, match, sigma_intensity);
   if (!std::isfinite(disparity_var)) return StereoStatus::kOutside;
   double idepth_var = disparity_var / jacobian_sq;  // alpha^2 sigma_lambda^2

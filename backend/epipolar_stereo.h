@@ -26,7 +26,11 @@ namespace pldvo {
 
 class EpipolarGeometry {
  public:
-  EpipolarGeometry(const PinholeCamera& camera, const SE3& cur_from_ref);
+  // `pose_covariance`: of the tangent (t; w) of the left perturbation Exp(delta) * cur_from_ref
+  // (the tracker's TrackingResult::pose_covariance), which PoseOffsetVar propagates to the
+  // image; zero: none.
+  EpipolarGeometry(const PinholeCamera& camera, const SE3& cur_from_ref,
+                   const Matrix6d& pose_covariance = Matrix6d::Zero());
 
   const PinholeCamera& camera() const { return camera_; }
   const SE3& cur_from_ref() const { return cur_from_ref_; }
@@ -50,6 +54,11 @@ class EpipolarGeometry {
   // Unit direction of x's epipolar line in the keyframe (towards the current camera's epipole
   // up to sign); false when x is (nearly) the epipole or there is no baseline.
   bool EpipolarDirectionInRef(const Eigen::Vector2d& pixel_in_ref, Eigen::Vector2d* dir) const;
+  // Variance of tau(x, d)'s offset along the unit `normal_in_cur` caused by the pose error,
+  // n^T J Sigma J^T n with J = d tau / d delta = d pi / dY [d I, -[Y]x], Y = R K^-1 (x; 1) + d t
+  // (the point times d, so that d = 0 is the point at infinity). Requires a valid projection.
+  double PoseOffsetVar(const Eigen::Vector2d& pixel_in_ref, double idepth,
+                       const Eigen::Vector2d& normal_in_cur) const;
 
  private:
   PinholeCamera camera_;
@@ -57,6 +66,8 @@ class EpipolarGeometry {
   Eigen::Matrix3d krki_;
   Eigen::Vector3d kt_;
   Eigen::Vector3d epipole_in_ref_h_;  // K c, c = -R^T t the current centre in the keyframe
+  Matrix6d pose_covariance_;
+  bool has_pose_covariance_ = false;
 };
 
 enum class StereoStatus {
@@ -93,7 +104,8 @@ double PatchSsd(const ImagePyramid& current, const EpipolarPatch& patch,
                 const Eigen::Vector2d& pixel_in_cur);
 
 // Disparity variances of Engel 2013 (pixels^2 along the current epipolar line).
-double GeometricDisparityVar(const EpipolarPatch& patch, double sigma_epipolar_px);
+// Geometric: the epipolar line's position variance (pixels^2) over cos^2 of the gradient angle.
+double GeometricDisparityVar(const EpipolarPatch& patch, double epipolar_position_var);
 double PhotometricDisparityVar(const ImagePyramid& current, const EpipolarPatch& patch,
                                const Eigen::Vector2d& pixel_in_cur, double sigma_intensity);
 

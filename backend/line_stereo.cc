@@ -88,9 +88,12 @@ StereoStatus LineGuidedStereo(const EpipolarGeometry& geometry, const Eigen::Vec
   const Eigen::Vector3d match_h(match_on_line.x(), match_on_line.y(), 1.0);
   const double line_position_var = match_h.dot(line_in_cur.cov * match_h);
   const double theta = std::asin(std::min(1.0, sin_theta));
+  const double epipolar_var =
+      options.sigma_epipolar_px * options.sigma_epipolar_px +
+      geometry.PoseOffsetVar(pixel_on_line, idepth,
+                             Eigen::Vector2d(-epipolar_dir.y(), epipolar_dir.x()));
   const double disparity_var =
-      LineDisparityVar(line_position_var + ref_line_position_var,
-                       options.sigma_epipolar_px * options.sigma_epipolar_px, theta);
+      LineDisparityVar(line_position_var + ref_line_position_var, epipolar_var, theta);
   const double alpha_sq = 1.0 / (jacobian_norm * jacobian_norm);
   observation->idepth = idepth;
   observation->disparity_var = disparity_var;

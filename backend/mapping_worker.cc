@@ -190,7 +190,7 @@ void MappingWorker::Run(const MappingJob& job) {
       case MappingJob::Kind::kUpdate:
         if (job.keyframe_id != keyframe_id_) return;  // for a keyframe no longer current
         mapper_.UpdateWithFrame(InReferenceBrightness(job.image, job.brightness), job.cur_from_kf,
-                                job.lines_in_cur);
+                                job.lines_in_cur, job.pose_covariance);
         ++num_updates_;
         break;
       case MappingJob::Kind::kLineDepths: {

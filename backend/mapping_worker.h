@@ -61,6 +61,8 @@ struct MappingJob {
   // kUpdate: cur_from_kf of the tracked frame and its lines matched to the keyframe edges.
   SE3 cur_from_kf;
   std::vector<MatchedLine> lines_in_cur;
+  // kUpdate: the tracked pose's covariance (tracking.pose_covariance; zero when not computed).
+  Matrix6d pose_covariance = Matrix6d::Zero();
   // kInitialize / kNewKeyframe: the new keyframe's traced edges and pyramid levels.
   EdgeTrace edges;
   int num_levels = 1;

@@ -508,6 +508,7 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, PreparedFrame
         job.frame_index = index;
         job.image = image;
         job.cur_from_kf = cur_from_kf;
+        job.pose_covariance = tracking.pose_covariance;
         job.brightness = brightness_;
         job.lines_in_cur = std::move(lines_in_cur);
         timing.wait_ms += mapper_->Submit(std::move(job));

@@ -1,11 +1,13 @@
 #include "backend/tracker.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
 
+#include "backend/normal_equations.h"
 #include "core/wall_clock.h"
 #include "residuals/covariance_models.h"
 #include "residuals/photometric_residual.h"
@@ -141,6 +143,26 @@ ResidualStatistics EvaluateResidualStatistics(const LeastSquaresProblem& problem
   return stats;
 }
 
+namespace {
+
+// The pose block of (J~^T J~)^-1 at the problem's current parameters; zero when H is singular.
+Matrix6d PoseCovarianceAtSolution(const LeastSquaresProblem& problem, const double* pose) {
+  NormalEquations equations(problem);
+  double cost = 0.0;
+  const int index = problem.ParameterBlockIndex(pose);
+  if (index < 0 || equations.TangentOffset(index) < 0 || !equations.Linearize(&cost)) {
+    return Matrix6d::Zero();
+  }
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(equations.hessian());
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return Matrix6d::Zero();
+  const Eigen::MatrixXd inverse =
+      ldlt.solve(Eigen::MatrixXd::Identity(equations.dimension(), equations.dimension()));
+  const int offset = equations.TangentOffset(index);
+  return inverse.block<6, 6>(offset, offset);
+}
+
+}  // namespace
+
 Tracker::Tracker(const TrackingOptions& options) : options_(options) {
   const std::string error = options_.Check();
   if (!error.empty()) throw std::invalid_argument(Where(__LINE__) + "tracking: " + error);
@@ -216,6 +238,9 @@ TrackingResult Tracker::Track(const TrackingReference& reference, const ImagePyr
             ? std::sqrt(2.0 * final_stats.photometric_cost / final_stats.photometric_valid_rows)
             : 0.0;
     result.levels.push_back(level_result);
+    if (options_.pose_covariance && level == options_.finest_level) {
+      result.pose_covariance = PoseCovarianceAtSolution(problem, pose);
+    }
   }
 
   result.cur_from_ref = PoseFromParameters(pose);

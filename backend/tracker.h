@@ -56,6 +56,9 @@ struct TrackingOptions {
   double min_intensity_correlation = 0.3;
   // Compute the reprojected edge pixels for the iteration callback (the paper's Fig. 2).
   bool record_edge_pixels = true;
+  // Compute the pose covariance (J^T J)^-1 of the finest level at the solution
+  // (TrackingResult::pose_covariance); the odometry hands it to the mapping's stereo.
+  bool pose_covariance = false;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
@@ -78,6 +81,9 @@ struct TrackingOptions {
             "below this (0.3; -1: off).");
     v.Field("record_edge_pixels", &record_edge_pixels,
             "Give the iteration callback the reprojected edge pixels (Fig. 2).");
+    v.Field("pose_covariance", &pose_covariance,
+            "Compute the pose covariance (J^T J)^-1 at the finest level's solution; the "
+            "mapping adds it to the epipolar line error of its stereo (default false).");
   }
   std::string Check() const;
 };
@@ -116,6 +122,10 @@ struct TrackingResult {
   double intensity_correlation = 0.0;  // the finest level's
   double final_rms = 0.0;
   double final_photometric_rms = 0.0;  // finest level, photometric rows only (0 without any)
+  // With TrackingOptions::pose_covariance: (J~^T J~)^-1 of the finest level at cur_from_ref,
+  // the pose block of it when the brightness is estimated too (whitened, robustified rows, so
+  // the inverse of the Gauss-Newton normal matrix); zero otherwise or when J~ is rank deficient.
+  Matrix6d pose_covariance = Matrix6d::Zero();
   int TotalIterations() const;
 };
 

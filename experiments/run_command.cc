@@ -201,7 +201,7 @@ int RunOdometryCommand(const CommandContext& context) {
   timing_file
       << "index,timestamp,status,keyframe_id,lines,matches,line_outliers,reference_points,"
          "alternatives,iterations,final_rms,inlier_fraction,intensity_correlation,brightness_a,"
-         "brightness_b";
+         "brightness_b,pose_sigma_t,pose_sigma_r_deg";
   for (const char* key : kTimingKeys) timing_file << "," << key << "_ms";
   timing_file << "\n";
   if (!written(trajectory_file, "trajectory.txt") || !written(timing_file, "timing.csv")) return 1;
@@ -346,7 +346,12 @@ int RunOdometryCommand(const CommandContext& context) {
                 << result.tracking.TotalIterations() << "," << std::setprecision(6)
                 << result.tracking.final_rms << "," << result.tracking.inlier_fraction << ","
                 << result.tracking.intensity_correlation << "," << result.tracking.brightness.a
-                << "," << result.tracking.brightness.b;
+                << "," << result.tracking.brightness.b << ","
+                << std::sqrt(result.tracking.pose_covariance.topLeftCorner<3, 3>().trace() / 3.0)
+                << ","
+                << std::sqrt(result.tracking.pose_covariance.bottomRightCorner<3, 3>().trace() /
+                             3.0) *
+                       180.0 / M_PI;
     for (double value : Values(row)) timing_file << "," << std::setprecision(4) << value;
     timing_file << "\n";
     if (!written(timing_file, "timing.csv")) return 1;

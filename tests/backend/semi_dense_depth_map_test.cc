@@ -340,6 +340,52 @@ TEST(EpipolarGeometryTest, ProjectionJacobianAndInverse) {
   EXPECT_NEAR(geometry.IdepthFromCurPixel(pixel, projected, plus - minus), idepth, 1e-9);
 }
 
+// The pose error's offset across the epipolar line, n^T J Sigma J^T n, against the offsets of
+// the point reprojected with Exp(delta) * cur_from_ref for delta ~ N(0, Sigma): a correlated
+// Sigma (2-5 mm, 0.1-0.3 deg), a near point, a far one and the point at infinity (d = 0).
+TEST(EpipolarGeometryTest, PoseOffsetVarMatchesMonteCarlo) {
+  const PinholeCamera camera = TestCamera();
+  const SE3 cur_from_ref = SE3::Exp((Vector6d() << 0.1, -0.05, 0.03, 0.02, 0.05, -0.01).finished());
+  Matrix6d a = Matrix6d::Zero();
+  a.diagonal() << 0.005, 0.003, 0.002, 0.005, 0.002, 0.003;
+  a(0, 4) = 0.003;  // translation correlated with rotation, as in tracking
+  a(1, 3) = -0.002;
+  const Matrix6d sigma = a * a.transpose();
+  const EpipolarGeometry geometry(camera, cur_from_ref, sigma);
+  EXPECT_EQ(EpipolarGeometry(camera, cur_from_ref)
+                .PoseOffsetVar(Eigen::Vector2d(50, 70), 0.4, Eigen::Vector2d(0, 1)),
+            0.0);
+  const Eigen::LLT<Matrix6d> llt(sigma);
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (const double idepth : {2.0, 0.4, 0.0}) {
+    const Eigen::Vector2d pixel(50.0, 70.0);
+    Eigen::Vector2d projected, farther;
+    ASSERT_TRUE(geometry.Project(pixel, idepth, &projected));
+    ASSERT_TRUE(geometry.Project(pixel, idepth + 0.1, &farther));
+    const Eigen::Vector2d along = (farther - projected).normalized();
+    const Eigen::Vector2d across(-along.y(), along.x());
+    const double model = geometry.PoseOffsetVar(pixel, idepth, across);
+    const int samples = 20000;
+    double sum = 0.0, sum_sq = 0.0;
+    for (int k = 0; k < samples; ++k) {
+      Vector6d z;
+      for (int i = 0; i < 6; ++i) z[i] = normal(rng);
+      const EpipolarGeometry perturbed(camera, SE3::Exp(llt.matrixL() * z) * cur_from_ref);
+      Eigen::Vector2d moved;
+      ASSERT_TRUE(perturbed.Project(pixel, idepth, &moved));
+      const double offset = across.dot(moved - projected);
+      sum += offset;
+      sum_sq += offset * offset;
+    }
+    const double mean = sum / samples;
+    const double variance = sum_sq / samples - mean * mean;
+    // 20000 samples: the sample variance's relative standard error is sqrt(2 / n) = 1%.
+    EXPECT_NEAR(variance / model, 1.0, 0.04) << "idepth " << idepth << " model " << model;
+    EXPECT_GT(model, 0.1) << "idepth " << idepth;  // pixels^2: the test is not trivially small
+  }
+}
+
 // A fronto-parallel textured plane at 2 m seen with a 10 cm sideways baseline: the SSD search
 // from a wide prior finds the true inverse depth within 3 sigma of its own variance.
 TEST(EpipolarStereoTest, SsdSearchFindsPlaneDepth) {

@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <map>
 #include <memory>
 #include <opencv2/core.hpp>
@@ -440,6 +442,57 @@ TEST(TrackerTest, PhotometricRmsCountsThePhotometricRowsOnly) {
   EXPECT_EQ(lines.final_photometric_rms, 0.0);
   EXPECT_NE(both.final_photometric_rms, both.final_rms);
   EXPECT_NEAR(both.final_photometric_rms, photometric.final_rms, 0.05 * photometric.final_rms);
+}
+
+// The pose covariance (J^T J)^-1 against the scatter of the poses tracked from 40 noise draws
+// of the current image (sigma 8 gray levels, photometric rows, least squares, GT depth with a
+// negligible variance, sigma_I set so that the model's 2 sigma_I^2 is the drawn variance). The
+// ratio c = trace(Sigma_model^-1 Sigma_sample) / 6 is 1 for a calibrated model; bilinear
+// interpolation averages the drawn noise of four pixels (variance x 4/9 for uniform sub-pixel
+// positions), so c is expected near 0.44-1, and a covariance off by a factor of 4 either way
+// (e.g. not whitened, or the wrong block) falls outside [0.25, 1.25].
+TEST(TrackerTest, PoseCovarianceMatchesTheScatterOverNoiseDraws) {
+  const FramePair& pair = Pair("textured");
+  GroundTruthReferenceOptions reference_options;
+  reference_options.idepth_var = 1e-12;
+  const TrackingReference reference =
+      MakePairReference(pair, reference_options, /*with_edges=*/false);
+  const double noise_sigma = 8.0;
+  TrackingOptions options = ModeOptions(Mode::kPhotometric, SolverOptions::Type::kGaussNewton);
+  options.problem.weighting.sigma_intensity = noise_sigma / std::sqrt(2.0);
+  options.problem.weighting.robust_threshold = 1e6;
+  options.solver.function_tolerance = 1e-12;
+  options.solver.max_iterations = 50;
+  options.pose_covariance = true;
+  const Tracker tracker(options);
+  EXPECT_TRUE(Tracker(ModeOptions(Mode::kPhotometric, SolverOptions::Type::kGaussNewton))
+                  .Track(reference, ImagePyramid(pair.cur_image, 4), SE3())
+                  .pose_covariance.isZero(0.0));  // off by default
+
+  cv::RNG rng(5);
+  std::vector<Vector6d> errors;
+  Matrix6d model = Matrix6d::Zero();
+  const int draws = 40;
+  for (int k = 0; k < draws; ++k) {
+    cv::Mat noisy = pair.cur_image.clone(), noise(noisy.size(), CV_32F);
+    rng.fill(noise, cv::RNG::NORMAL, 0.0, noise_sigma);
+    noisy.convertTo(noisy, CV_32F);
+    noisy += noise;
+    const TrackingResult result = tracker.Track(reference, ImagePyramid(noisy, 4), SE3());
+    ASSERT_NE(result.status, TrackingStatus::kLost);
+    errors.push_back((result.cur_from_ref * pair.cur_from_ref.Inverse()).Log());
+    model += result.pose_covariance / draws;
+  }
+  Vector6d mean = Vector6d::Zero();
+  for (const Vector6d& e : errors) mean += e / draws;
+  Matrix6d sample = Matrix6d::Zero();
+  for (const Vector6d& e : errors) sample += (e - mean) * (e - mean).transpose() / (draws - 1);
+  const double ratio = (model.inverse() * sample).trace() / 6.0;
+  EXPECT_GT(ratio, 0.25) << "model diagonal " << model.diagonal().transpose();
+  EXPECT_LT(ratio, 1.25) << "model diagonal " << model.diagonal().transpose();
+  EXPECT_LT(model.diagonal().head<3>().cwiseSqrt().maxCoeff(), 1e-3);  // sub-mm: a real pose
+  std::printf("pose covariance: trace(model^-1 sample) / 6 = %.3f, model sigma t %.2e m\n", ratio,
+              std::sqrt(model.diagonal().head<3>().mean()));
 }
 
 TEST(TrackerTest, CeresTrackerRecoversThePoseToo) {
