@@ -17,13 +17,13 @@ EpipolarGeometry::EpipolarGeometry(const PinholeCamera& camera, const SE3& cur_f
                                    const Matrix6d& pose_covariance)
     : camera_(camera),
       cur_from_ref_(cur_from_ref),
+      rotation_(cur_from_ref.rotation_matrix()),
       pose_covariance_(pose_covariance),
       has_pose_covariance_(!pose_covariance.isZero(0.0)) {
   const Eigen::Matrix3d k = camera.K();
-  krki_ = k * cur_from_ref.rotation_matrix() * k.inverse();
+  krki_ = k * rotation_ * k.inverse();
   kt_ = k * cur_from_ref.translation();
-  const Eigen::Vector3d centre_in_ref =
-      -(cur_from_ref.rotation_matrix().transpose() * cur_from_ref.translation());
+  const Eigen::Vector3d centre_in_ref = -(rotation_.transpose() * cur_from_ref.translation());
   epipole_in_ref_h_ = k * centre_in_ref;
 }
 
@@ -64,8 +64,8 @@ bool EpipolarGeometry::EpipolarDirectionInRef(const Eigen::Vector2d& pixel_in_re
 double EpipolarGeometry::PoseOffsetVar(const Eigen::Vector2d& pixel_in_ref, double idepth,
                                        const Eigen::Vector2d& normal_in_cur) const {
   if (!has_pose_covariance_) return 0.0;
-  const Eigen::Vector3d y = cur_from_ref_.rotation_matrix() * camera_.Unproject(pixel_in_ref) +
-                            idepth * cur_from_ref_.translation();
+  const Eigen::Vector3d y =
+      rotation_ * camera_.Unproject(pixel_in_ref) + idepth * cur_from_ref_.translation();
   const Eigen::RowVector3d n_dpi = normal_in_cur.transpose() * camera_.ProjectJacobian(y);
   // dY / d(t; w) = [d I, -[Y]x], and n_dpi (-[Y]x) w = w . (Y x n_dpi).
   Eigen::Matrix<double, 1, 6> row;

@@ -63,6 +63,7 @@ class EpipolarGeometry {
  private:
   PinholeCamera camera_;
   SE3 cur_from_ref_;
+  Eigen::Matrix3d rotation_;  // of cur_from_ref, once rather than per pixel
   Eigen::Matrix3d krki_;
   Eigen::Vector3d kt_;
   Eigen::Vector3d epipole_in_ref_h_;  // K c, c = -R^T t the current centre in the keyframe

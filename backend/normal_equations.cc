@@ -62,7 +62,7 @@ bool NormalEquations::Linearize(double* cost) {
     double sq_norm = 0.0;
     for (int r = 0; r < rows; ++r) sq_norm += residuals_[r] * residuals_[r];
 
-    // Robust correction of a LossFunction (Ceres' Corrector, see the header).
+    // Robust correction of a LossFunction (Ceres' Corrector; equations: gauss_newton_solver.h).
     double residual_scaling = 1.0;
     double jacobian_scaling = 1.0;
     double alpha_sq_norm = 0.0;

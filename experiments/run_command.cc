@@ -339,6 +339,11 @@ int RunOdometryCommand(const CommandContext& context) {
     row.tracking_thread = t.tracking_thread_ms;
     row.total = MsSince(frame_start);
     if (result.status != FrameStatus::kFailed) rows.push_back(row);
+    // RMS sigma per axis of the tracked pose (tracking.pose_covariance; 0 without it).
+    const Matrix6d& pose_covariance = result.tracking.pose_covariance;
+    const double pose_sigma_t = std::sqrt(pose_covariance.topLeftCorner<3, 3>().trace() / 3.0);
+    const double pose_sigma_r_deg =
+        std::sqrt(pose_covariance.bottomRightCorner<3, 3>().trace() / 3.0) * 180.0 / M_PI;
     timing_file << i << "," << std::setprecision(17) << result.timestamp << ","
                 << FrameStatusName(result.status) << "," << result.keyframe_id << ","
                 << result.num_lines << "," << result.num_matches << "," << result.num_line_outliers
@@ -346,12 +351,8 @@ int RunOdometryCommand(const CommandContext& context) {
                 << result.tracking.TotalIterations() << "," << std::setprecision(6)
                 << result.tracking.final_rms << "," << result.tracking.inlier_fraction << ","
                 << result.tracking.intensity_correlation << "," << result.tracking.brightness.a
-                << "," << result.tracking.brightness.b << ","
-                << std::sqrt(result.tracking.pose_covariance.topLeftCorner<3, 3>().trace() / 3.0)
-                << ","
-                << std::sqrt(result.tracking.pose_covariance.bottomRightCorner<3, 3>().trace() /
-                             3.0) *
-                       180.0 / M_PI;
+                << "," << result.tracking.brightness.b << "," << pose_sigma_t << ","
+                << pose_sigma_r_deg;
     for (double value : Values(row)) timing_file << "," << std::setprecision(4) << value;
     timing_file << "\n";
     if (!written(timing_file, "timing.csv")) return 1;
