@@ -22,7 +22,7 @@
 #include <string>
 
 #include "core/config_io.h"
-#include "core/synthetic/synthetic_sequence.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 
 namespace pldvo::test {
 

@@ -3,7 +3,7 @@
 #ifndef PLDVO_TESTS_SMALL_LOWTEX_OPTIONS_H_
 #define PLDVO_TESTS_SMALL_LOWTEX_OPTIONS_H_
 
-#include "core/synthetic/synthetic_sequence.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 
 namespace pldvo::test {
 

@@ -11,8 +11,8 @@
 
 #include <vector>
 
-#include "backend/edge_ba_simulation.h"
-#include "backend/edge_ba_solver.h"
+#include "backend/edge_ba/edge_ba_solver.h"
+#include "experiments/evaluation/edge_ba_simulation.h"
 
 namespace pldvo {
 namespace {

@@ -24,7 +24,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/synthetic/synthetic_sequence.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 #include "frontend/line_frontend.h"
 
 namespace pldvo {

@@ -10,10 +10,10 @@
 
 #include <vector>
 
-#include "backend/depth_mapper.h"
-#include "backend/mapping_ground_truth.h"
-#include "backend/reference_builder.h"
-#include "experiments/synthetic_pairs.h"
+#include "backend/mapping/depth_mapper.h"
+#include "backend/odometry/reference_builder.h"
+#include "experiments/evaluation/mapping_ground_truth.h"
+#include "experiments/evaluation/synthetic_pairs.h"
 
 namespace pldvo {
 namespace {

@@ -1,4 +1,4 @@
-// Rendering speed of the synthetic sequence generator (core/synthetic/, docs/synthetic.md):
+// Rendering speed of the synthetic sequence generator (experiments/synthetic/, docs/synthetic.md):
 // one 640x480 frame per iteration, with the frame rate as the counter `fps`.
 //   Render/<preset>/threads:<T>        RenderFrame (supersampling 4, noise), frame index cycling
 //   Render/lowtex_blur5/threads:<T>    with 5-sample motion blur
@@ -8,7 +8,7 @@
 
 #include <string>
 
-#include "core/synthetic/synthetic_sequence.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 
 namespace pldvo::synthetic {
 namespace {

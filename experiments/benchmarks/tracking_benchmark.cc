@@ -12,8 +12,8 @@
 #include <memory>
 #include <string>
 
-#include "backend/tracker.h"
-#include "experiments/synthetic_pairs.h"
+#include "backend/tracking/tracker.h"
+#include "experiments/evaluation/synthetic_pairs.h"
 
 namespace pldvo {
 namespace {

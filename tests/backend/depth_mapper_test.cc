@@ -1,13 +1,13 @@
 // Semi-dense mapping on a small synthetic sequence (160x120, 8 frames, textured preset, GT poses)
-// through experiments/mapping_evaluation.h: convergence from a random initialisation, line-guided
-// vs photometric stereo on edge pixels, the 3D line regularisation, NEES and propagation.
-// Measured values at this config (pldvo mapeval with the same --set keys) are quoted next to each
-// tolerance; the tolerances leave ~2x margin on them and sit far from what a broken stage gives
-// (the random initialisation has a median relative error of ~60%). The TESTs reading Result() or
-// TexturedSeed2Result() share one evaluation: ctest runs this binary as one process (ONE_PROCESS,
-// tests/CMakeLists.txt), and the evaluations of one sequence render its frames once (the render
-// cache).
-#include "backend/depth_mapper.h"
+// through experiments/evaluation/mapping_evaluation.h: convergence from a random initialisation,
+// line-guided vs photometric stereo on edge pixels, the 3D line regularisation, NEES and
+// propagation. Measured values at this config (pldvo mapeval with the same --set keys) are quoted
+// next to each tolerance; the tolerances leave ~2x margin on them and sit far from what a broken
+// stage gives (the random initialisation has a median relative error of ~60%). The TESTs reading
+// Result() or TexturedSeed2Result() share one evaluation: ctest runs this binary as one process
+// (ONE_PROCESS, tests/CMakeLists.txt), and the evaluations of one sequence render its frames once
+// (the render cache).
+#include "backend/mapping/depth_mapper.h"
 
 #include <gtest/gtest.h>
 
@@ -17,8 +17,8 @@
 #include <string>
 #include <utility>
 
-#include "experiments/mapping_evaluation.h"
-#include "experiments/synthetic_pairs.h"
+#include "experiments/evaluation/mapping_evaluation.h"
+#include "experiments/evaluation/synthetic_pairs.h"
 #include "tests/render_cache.h"
 
 namespace pldvo {

@@ -1,8 +1,8 @@
-// Edge BA lines -> keyframe inverse depths (backend/edge_ba_line_depth.h,
+// Edge BA lines -> keyframe inverse depths (backend/edge_ba/edge_ba_line_depth.h,
 // DepthMapper::FuseLineDepths): the ray/line intersection, its first-order variance against Monte
 // Carlo sampling of the line's tangent perturbation, the covariance change of frame, and the
 // fusion into a depth map with wrong edge depths.
-#include "backend/edge_ba_line_depth.h"
+#include "backend/edge_ba/edge_ba_line_depth.h"
 
 #include <ceres/line_manifold.h>
 #include <gtest/gtest.h>
@@ -13,9 +13,9 @@
 #include <cstdio>
 #include <random>
 
-#include "backend/depth_mapper.h"
-#include "backend/edge_ba_simulation.h"
-#include "backend/edge_ba_solver.h"
+#include "backend/edge_ba/edge_ba_solver.h"
+#include "backend/mapping/depth_mapper.h"
+#include "experiments/evaluation/edge_ba_simulation.h"
 
 namespace pldvo {
 namespace {

@@ -1,8 +1,8 @@
-// EdgeBAMotionPrior (backend/edge_ba_motion_prior.h): zero at the measured relative pose, the
-// whitened translation / rotation error of a known perturbation, automatic-differentiation
+// EdgeBAMotionPrior (backend/edge_ba/edge_ba_motion_prior.h): zero at the measured relative pose,
+// the whitened translation / rotation error of a known perturbation, automatic-differentiation
 // Jacobians against numeric differences through SE3Manifold; and the problem builder
 // adds one prior per consecutive keyframe pair that carries a tracked relative pose.
-#include "backend/edge_ba_motion_prior.h"
+#include "backend/edge_ba/edge_ba_motion_prior.h"
 
 #include <ceres/gradient_checker.h>
 #include <gtest/gtest.h>
@@ -10,8 +10,8 @@
 #include <memory>
 #include <vector>
 
-#include "backend/edge_ba_problem_builder.h"
-#include "backend/edge_ba_simulation.h"
+#include "backend/edge_ba/edge_ba_problem_builder.h"
+#include "experiments/evaluation/edge_ba_simulation.h"
 #include "residuals/se3_manifold.h"
 
 namespace pldvo {

@@ -11,7 +11,7 @@
 #include <random>
 #include <vector>
 
-#include "backend/edge_ba_line_triangulation.h"
+#include "backend/edge_ba/edge_ba_line_triangulation.h"
 #include "core/pinhole_camera.h"
 #include "core/se3.h"
 #include "residuals/baseline_prior_residual.h"

@@ -1,6 +1,6 @@
 // Windowed edge bundle adjustment on simulated observations of the synthetic generator's scene
-// edges (core/synthetic): accuracy against the ground truth, gauge, rank of the Jacobian at the
-// solution, line handling, and the asynchronous EdgeBundleAdjuster.
+// edges (experiments/synthetic): accuracy against the ground truth, gauge, rank of the Jacobian at
+// the solution, line handling, and the asynchronous EdgeBundleAdjuster.
 #include <ceres/problem.h>
 #include <gtest/gtest.h>
 
@@ -9,11 +9,11 @@
 #include <cmath>
 #include <vector>
 
-#include "backend/edge_ba_adjuster.h"
-#include "backend/edge_ba_problem_builder.h"
-#include "backend/edge_ba_simulation.h"
-#include "backend/edge_ba_solver.h"
-#include "core/synthetic/synthetic_sequence.h"
+#include "backend/edge_ba/edge_ba_adjuster.h"
+#include "backend/edge_ba/edge_ba_problem_builder.h"
+#include "backend/edge_ba/edge_ba_solver.h"
+#include "experiments/evaluation/edge_ba_simulation.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 #include "residuals/baseline_prior_residual.h"
 
 namespace pldvo {

@@ -1,8 +1,8 @@
-// KeyframeWindow (backend/keyframe_window.h): observations are the centre pixels of traced
+// KeyframeWindow (backend/odometry/keyframe_window.h): observations are the centre pixels of traced
 // segments; matches to the previous keyframe give the 3D line association; keyframes leave the
 // window in order and their lines become anchored; a result moves the snapshot's keyframes to
 // their refined poses and later keyframes rigidly with the newest refined one.
-#include "backend/keyframe_window.h"
+#include "backend/odometry/keyframe_window.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
-// 3D line regularisation (backend/line_regularizer.h): known 3D lines, noisy inverse depths with
-// outliers -> the RANSAC + weighted least-squares line is recovered, outliers are rejected and the
-// pixels' depth error drops.
-#include "backend/line_regularizer.h"
+// 3D line regularisation (backend/mapping/line_regularizer.h): known 3D lines, noisy inverse depths
+// with outliers -> the RANSAC + weighted least-squares line is recovered, outliers are rejected and
+// the pixels' depth error drops.
+#include "backend/mapping/line_regularizer.h"
 
 #include <gtest/gtest.h>
 

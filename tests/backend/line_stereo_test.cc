@@ -1,7 +1,7 @@
-// Line-guided stereo (backend/line_stereo.h): the plane-intersection triangulation of eqs. 8-9 is
-// exact on noiseless geometry, and the disparity variance of eq. 10 (both edges' parts) matches
-// Monte Carlo sampling.
-#include "backend/line_stereo.h"
+// Line-guided stereo (backend/mapping/line_stereo.h): the plane-intersection triangulation of eqs.
+// 8-9 is exact on noiseless geometry, and the disparity variance of eq. 10 (both edges' parts)
+// matches Monte Carlo sampling.
+#include "backend/mapping/line_stereo.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
-// The mapping evaluation's statistics (backend/mapping_ground_truth.h): on hypotheses drawn from
-// their own predicted Gaussian the NEES decomposition must give its chi^2(1) values, and the
-// continuity mask must cut exactly around depth steps.
-#include "backend/mapping_ground_truth.h"
+// The mapping evaluation's statistics (experiments/evaluation/mapping_ground_truth.h): on
+// hypotheses drawn from their own predicted Gaussian the NEES decomposition must give its chi^2(1)
+// values, and the continuity mask must cut exactly around depth steps.
+#include "experiments/evaluation/mapping_ground_truth.h"
 
 #include <gtest/gtest.h>
 

@@ -14,11 +14,11 @@
 #include <string>
 #include <vector>
 
-#include "backend/odometry.h"
-#include "backend/odometry_config.h"
+#include "backend/odometry/odometry.h"
+#include "backend/odometry/odometry_config.h"
 #include "core/config_io.h"
 #include "core/evaluation.h"
-#include "core/synthetic/synthetic_sequence.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 #include "tests/backend/rendered_sequence.h"
 #include "tests/render_cache.h"
 

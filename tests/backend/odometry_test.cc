@@ -4,7 +4,7 @@
 // triggers the re-initialisation and the odometry continues; with the affine brightness model a
 // global gain and bias per frame is followed; the config tree loads the shipped configs and
 // rejects unknown keys.
-#include "backend/odometry.h"
+#include "backend/odometry/odometry.h"
 
 #include <gtest/gtest.h>
 
@@ -17,11 +17,11 @@
 #include <string>
 #include <vector>
 
-#include "backend/frame_preparer.h"
-#include "backend/odometry_config.h"
+#include "backend/odometry/frame_preparer.h"
+#include "backend/odometry/odometry_config.h"
 #include "core/config_io.h"
 #include "core/evaluation.h"
-#include "core/synthetic/synthetic_sequence.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 #include "tests/backend/rendered_sequence.h"
 
 namespace pldvo {

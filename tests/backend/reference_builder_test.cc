@@ -1,6 +1,6 @@
 // The tracking reference's point budget and edge foot points (reference_builder.h) and the
 // mapping worker's wait-instead-of-drop mode and inline lag (mapping_worker.h).
-#include "backend/reference_builder.h"
+#include "backend/odometry/reference_builder.h"
 
 #include <gtest/gtest.h>
 
@@ -11,9 +11,9 @@
 #include <set>
 #include <utility>
 
-#include "backend/depth_mapper.h"
-#include "backend/mapping_worker.h"
-#include "backend/semi_dense_depth_map.h"
+#include "backend/mapping/depth_mapper.h"
+#include "backend/mapping/semi_dense_depth_map.h"
+#include "backend/odometry/mapping_worker.h"
 #include "core/image_pyramid.h"
 #include "core/pinhole_camera.h"
 #include "frontend/line_frontend.h"

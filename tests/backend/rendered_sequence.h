@@ -6,7 +6,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "core/synthetic/synthetic_sequence.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 #include "tests/render_cache.h"
 #include "tests/small_lowtex_options.h"
 

@@ -1,6 +1,6 @@
-// RetryTrigger (backend/retry_trigger.h): the photometric RMS decides, and a slow drift of the
-// RMS cannot drag the running mean along and silence the retries.
-#include "backend/retry_trigger.h"
+// RetryTrigger (backend/odometry/retry_trigger.h): the photometric RMS decides, and a slow drift of
+// the RMS cannot drag the running mean along and silence the retries.
+#include "backend/odometry/retry_trigger.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // The semi-dense depth map's EKF update and bookkeeping, the epipolar geometry and the SSD search
-// of backend/epipolar_stereo.h, propagation and the output helpers.
-#include "backend/semi_dense_depth_map.h"
+// of backend/mapping/epipolar_stereo.h, propagation and the output helpers.
+#include "backend/mapping/semi_dense_depth_map.h"
 
 #include <gtest/gtest.h>
 
@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "backend/depth_map_io.h"
-#include "backend/depth_propagation.h"
-#include "backend/epipolar_stereo.h"
+#include "backend/mapping/depth_map_io.h"
+#include "backend/mapping/depth_propagation.h"
+#include "backend/mapping/epipolar_stereo.h"
 #include "tests/random_texture.h"
 
 namespace pldvo {

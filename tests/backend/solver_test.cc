@@ -1,6 +1,6 @@
 // The two solvers on LeastSquaresProblem: same minimum on Euclidean, manifold and robust
 // problems; the problem's conversion to ceres::Problem; input checks.
-#include "backend/solver.h"
+#include "backend/optimization/solver.h"
 
 #include <ceres/ceres.h>
 #include <gtest/gtest.h>
@@ -10,9 +10,9 @@
 #include <random>
 #include <vector>
 
-#include "backend/ceres_solver.h"
-#include "backend/gauss_newton_solver.h"
-#include "backend/least_squares_problem.h"
+#include "backend/optimization/ceres_solver.h"
+#include "backend/optimization/gauss_newton_solver.h"
+#include "backend/optimization/least_squares_problem.h"
 #include "core/random_draws.h"
 #include "residuals/se3_manifold.h"
 

@@ -1,7 +1,7 @@
 // Tracking on synthetic frame pairs with ground-truth depth, poses and 3D edges (320x240):
 // reference construction, solver agreement on one tracking problem, pose recovery for
 // photometric-only, line-only and both, the iteration callback and loss of track.
-#include "backend/tracker.h"
+#include "backend/tracking/tracker.h"
 
 #include <gtest/gtest.h>
 
@@ -15,10 +15,10 @@
 #include <tuple>
 #include <vector>
 
-#include "backend/problem_builder.h"
-#include "backend/solver.h"
-#include "backend/tracking_reference.h"
-#include "experiments/synthetic_pairs.h"
+#include "backend/optimization/solver.h"
+#include "backend/tracking/problem_builder.h"
+#include "backend/tracking/tracking_reference.h"
+#include "experiments/evaluation/synthetic_pairs.h"
 #include "residuals/se3_manifold.h"
 
 namespace pldvo {

@@ -1,7 +1,7 @@
-// The two-view bootstrap (backend/two_view_bootstrap.h) on a small rendered textured sequence
-// (320x240, 36 frames) against its ground truth: the second view's pose and frame 0's map; and
-// its errors when the camera does not move or the image has no corners.
-#include "backend/two_view_bootstrap.h"
+// The two-view bootstrap (backend/odometry/two_view_bootstrap.h) on a small rendered textured
+// sequence (320x240, 36 frames) against its ground truth: the second view's pose and frame 0's map;
+// and its errors when the camera does not move or the image has no corners.
+#include "backend/odometry/two_view_bootstrap.h"
 
 #include <gtest/gtest.h>
 
@@ -10,10 +10,10 @@
 #include <stdexcept>
 #include <vector>
 
-#include "backend/odometry_config.h"
+#include "backend/odometry/odometry_config.h"
 #include "core/dataset.h"
 #include "core/evaluation.h"
-#include "core/synthetic/synthetic_sequence.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 #include "tests/render_cache.h"
 #include "tests/small_lowtex_options.h"
 

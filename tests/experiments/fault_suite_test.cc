@@ -25,8 +25,8 @@
 #include <string>
 #include <vector>
 
-#include "core/synthetic/synthetic_sequence.h"
 #include "core/trajectory_io.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 #include "tests/experiments/test_folder.h"
 #include "tests/render_cache.h"
 #include "tests/small_lowtex_options.h"

@@ -15,10 +15,10 @@
 #include <string>
 #include <vector>
 
-#include "backend/odometry_config.h"
+#include "backend/odometry/odometry_config.h"
 #include "core/config_io.h"
-#include "core/synthetic/synthetic_sequence.h"
 #include "core/trajectory_io.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 #include "tests/experiments/test_folder.h"
 #include "tests/render_cache.h"
 #include "tests/small_lowtex_options.h"

@@ -1,11 +1,11 @@
-#include "experiments/solver_comparison.h"
+#include "backend/odometry/solver_comparison.h"
 
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <string>
 
-#include "backend/tracker.h"
+#include "backend/tracking/tracker.h"
 #include "core/se3.h"
 
 namespace pldvo {

@@ -13,9 +13,9 @@
 #include <memory>
 #include <set>
 
-#include "core/synthetic/synthetic_sequence.h"
+#include "experiments/evaluation/line_match_ground_truth.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 #include "frontend/line_frontend.h"
-#include "frontend/line_match_ground_truth.h"
 #include "frontend/line_refiner.h"
 #include "tests/frontend/line_ground_truth.h"
 #include "tests/render_cache.h"

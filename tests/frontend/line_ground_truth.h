@@ -18,7 +18,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "core/synthetic/synthetic_sequence.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 #include "frontend/line_segment.h"
 
 namespace pldvo::test {

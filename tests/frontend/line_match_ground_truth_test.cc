@@ -1,15 +1,15 @@
-// JudgeLineMatchByDepth (frontend/line_match_ground_truth.h): exact cases on a plane and at a depth
-// edge, agreement with the scene-edge judgement of tests/frontend/line_ground_truth.h on lowtex,
-// and the match precision on textured, where most matches are between texture lines that no
-// modelled scene edge verifies (docs/line_frontend.md).
-#include "frontend/line_match_ground_truth.h"
+// JudgeLineMatchByDepth (experiments/evaluation/line_match_ground_truth.h): exact cases on a plane
+// and at a depth edge, agreement with the scene-edge judgement of
+// tests/frontend/line_ground_truth.h on lowtex, and the match precision on textured, where most
+// matches are between texture lines that no modelled scene edge verifies (docs/line_frontend.md).
+#include "experiments/evaluation/line_match_ground_truth.h"
 
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <map>
 
-#include "core/synthetic/synthetic_sequence.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 #include "frontend/line_frontend.h"
 #include "tests/frontend/line_ground_truth.h"
 #include "tests/render_cache.h"

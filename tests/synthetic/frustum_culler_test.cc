@@ -1,14 +1,14 @@
-// Tests of FrustumCuller (core/synthetic/frustum_culler.h): culling is exact, i.e. a ray through
-// the image rectangle hits the same surface at the same depth whether it tests the culled boxes
-// or every primitive, and it does drop boxes.
-#include "core/synthetic/frustum_culler.h"
+// Tests of FrustumCuller (experiments/synthetic/frustum_culler.h): culling is exact, i.e. a ray
+// through the image rectangle hits the same surface at the same depth whether it tests the culled
+// boxes or every primitive, and it does drop boxes.
+#include "experiments/synthetic/frustum_culler.h"
 
 #include <gtest/gtest.h>
 
 #include <vector>
 
-#include "core/synthetic/synthetic_internal.h"
-#include "core/synthetic/synthetic_sequence.h"
+#include "experiments/synthetic/synthetic_internal.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 #include "tests/small_lowtex_options.h"
 
 namespace pldvo::synthetic {

@@ -7,8 +7,8 @@
 #include <cmath>
 #include <iostream>
 
-#include "core/synthetic/synthetic_internal.h"
-#include "core/synthetic/synthetic_sequence.h"
+#include "experiments/synthetic/synthetic_internal.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 
 namespace pldvo::synthetic {
 namespace {

@@ -13,7 +13,7 @@
 #include <fstream>
 #include <string>
 
-#include "core/synthetic/synthetic_sequence.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 
 namespace pldvo::test {
 namespace {

@@ -1,6 +1,6 @@
-// Tests of the synthetic sequence generator (core/synthetic/synthetic_sequence.h): photometric
-// consistency of GT depth + GT poses, exactness of GT depth on known planes, agreement of the
-// scene's 3D edges with image edges, determinism (also across compilers), texture presets,
+// Tests of the synthetic sequence generator (experiments/synthetic/synthetic_sequence.h):
+// photometric consistency of GT depth + GT poses, exactness of GT depth on known planes, agreement
+// of the scene's 3D edges with image edges, determinism (also across compilers), texture presets,
 // trajectory validity. Images are small (320x240, 160x120) so the whole file runs in seconds.
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -18,7 +18,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/synthetic/synthetic_sequence.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 
 namespace pldvo::synthetic {
 namespace {

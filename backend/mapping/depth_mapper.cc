@@ -1,0 +1,305 @@
+#include "backend/mapping/depth_mapper.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+#include <string>
+
+#include "backend/mapping/depth_regularizer.h"
+#include "backend/mapping/line_stereo.h"
+#include "core/wall_clock.h"
+
+namespace pldvo {
+
+DepthMapper::DepthMapper(const PinholeCamera& camera, const MappingOptions& options)
+    : camera_(camera), options_(options) {
+  const std::string camera_error = camera.Check();
+  if (!camera_error.empty()) throw std::invalid_argument("DepthMapper: camera: " + camera_error);
+  const std::string error = options.Check();
+  if (!error.empty()) throw std::invalid_argument("DepthMapper: " + error);
+}
+
+void DepthMapper::SetKeyframe(const cv::Mat& image, const EdgeTrace& edges) {
+  if (image.empty() || image.cols != camera_.width || image.rows != camera_.height ||
+      image.channels() != 1) {
+    throw std::invalid_argument("DepthMapper: keyframe must be a gray image of the camera's size");
+  }
+  if (!edges.id_map.empty() &&
+      (edges.id_map.cols != image.cols || edges.id_map.rows != image.rows)) {
+    throw std::invalid_argument("DepthMapper: edge id map size differs from the image");
+  }
+  keyframe_ = ImagePyramid(image, 1);
+  edges_ = edges;
+  map_ = SemiDenseDepthMap(image.cols, image.rows);
+  map_.SelectPixels(keyframe_, edges_.id_map, options_);
+  line_in_ref_by_id_.clear();
+  line_cov_in_ref_by_id_.clear();
+  for (const TracedLine& line : edges_.lines) {
+    if (line.id < 0) continue;
+    if (line.id >= static_cast<int>(line_in_ref_by_id_.size())) {
+      line_in_ref_by_id_.resize(line.id + 1, Eigen::Vector3d::Zero());
+      line_cov_in_ref_by_id_.resize(line.id + 1, Eigen::Matrix3d::Zero());
+    }
+    line_in_ref_by_id_[line.id] = line.segment.line;
+    line_cov_in_ref_by_id_[line.id] = line.segment.line_cov;
+  }
+}
+
+void DepthMapper::InitializeKeyframe(const cv::Mat& image, const EdgeTrace& edges) {
+  SetKeyframe(image, edges);
+  if (options_.init == MappingOptions::Init::kRandom) {
+    map_.InitializeRandom(options_.init_idepth_min, options_.init_idepth_max,
+                          options_.init_idepth_var, options_.init_seed, options_.validity_initial);
+  } else {
+    map_.InitializeConstant(options_.init_idepth, options_.init_idepth_var,
+                            options_.validity_initial);
+  }
+}
+
+void DepthMapper::InitializeKeyframeFromDepth(const cv::Mat& image, const EdgeTrace& edges,
+                                              const cv::Mat& depth, double idepth_var) {
+  SetKeyframe(image, edges);
+  map_.InitializeFromDepth(depth, idepth_var, options_.validity_initial);
+}
+
+bool DepthMapper::PriorInterval(int index, double* idepth_min, double* idepth_max,
+                                double* idepth_centre) const {
+  *idepth_min = options_.min_idepth;
+  *idepth_max = options_.max_idepth;
+  *idepth_centre = options_.init_idepth;
+  if (!map_.valid(index)) return true;
+  const double d = map_.idepth(index);
+  const double range = options_.search_sigmas * std::sqrt(map_.idepth_var(index));
+  *idepth_min = std::max(options_.min_idepth, d - range);
+  *idepth_max = std::min(options_.max_idepth, d + range);
+  *idepth_centre = std::clamp(d, *idepth_min, *idepth_max);
+  return *idepth_max > *idepth_min;
+}
+
+StereoStatus DepthMapper::ObserveOnLine(int index, const EpipolarGeometry& geometry,
+                                        const MatchedLine& line_in_cur, double idepth_min,
+                                        double idepth_max, const ImagePyramid* current,
+                                        const EpipolarPatch* patch,
+                                        StereoObservation* observation) const {
+  const Eigen::Vector2d pixel(index % map_.width(), index / map_.width());
+  const int edge = map_.edge_id(index);
+  // The foot point of the pixel on l1 and l1's position variance there (the pixel itself and
+  // 0 when l1 is unknown).
+  Eigen::Vector2d edge_pixel = pixel;
+  double ref_line_position_var = 0.0;
+  if (edge < static_cast<int>(line_in_ref_by_id_.size())) {
+    const Eigen::Vector3d& l1 = line_in_ref_by_id_[edge];
+    edge_pixel -= (l1.x() * pixel.x() + l1.y() * pixel.y() + l1.z()) * l1.head<2>();
+    if (options_.line_stereo_keyframe_line_var) {
+      const Eigen::Vector3d foot(edge_pixel.x(), edge_pixel.y(), 1.0);
+      ref_line_position_var = foot.dot(line_cov_in_ref_by_id_[edge] * foot);
+    }
+  }
+  return LineGuidedStereo(geometry, pixel, edge_pixel, ref_line_position_var,
+                          line_in_cur.line_in_cur, idepth_min, idepth_max, options_, current, patch,
+                          observation);
+}
+
+std::vector<char> DepthMapper::InconsistentLineMatches(
+    const EpipolarGeometry& geometry, const std::vector<MatchedLine>& lines_in_cur) const {
+  std::vector<int> inside(lines_in_cur.size(), 0), outside(lines_in_cur.size(), 0);
+  for (int i = 0; i < map_.num_pixels(); ++i) {
+    const int edge = map_.edge_id(i);
+    if (edge < 0 || edge >= static_cast<int>(lines_in_cur.size()) || !lines_in_cur[edge].matched ||
+        !map_.valid(i) || !map_.candidate(i)) {
+      continue;
+    }
+    double idepth_min, idepth_max, idepth_centre;
+    if (!PriorInterval(i, &idepth_min, &idepth_max, &idepth_centre)) continue;
+    StereoObservation observation;
+    const StereoStatus status = ObserveOnLine(i, geometry, lines_in_cur[edge], idepth_min,
+                                              idepth_max, nullptr, nullptr, &observation);
+    inside[edge] += status == StereoStatus::kOk;
+    outside[edge] += status == StereoStatus::kLineOutOfRange;
+  }
+  std::vector<char> inconsistent(lines_in_cur.size(), 0);
+  for (size_t e = 0; e < lines_in_cur.size(); ++e) {
+    const int votes = inside[e] + outside[e];
+    inconsistent[e] = votes >= options_.line_match_min_votes &&
+                      outside[e] > options_.line_match_max_outside_fraction * votes;
+  }
+  return inconsistent;
+}
+
+void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
+                              const EpipolarGeometry& geometry,
+                              const std::vector<MatchedLine>& lines_in_cur,
+                              FrameUpdateStats* stats) {
+  const Eigen::Vector2d pixel(index % map_.width(), index / map_.width());
+  const bool valid = map_.valid(index);
+  double idepth_min, idepth_max, idepth_centre;
+  if (!PriorInterval(index, &idepth_min, &idepth_max, &idepth_centre)) return;
+  EpipolarPatch patch;
+  const StereoStatus patch_status =
+      MakeEpipolarPatch(keyframe_, geometry, pixel, idepth_centre, options_, &patch);
+  StereoObservation observation;
+  StereoStatus status = StereoStatus::kBadGeometry;
+
+  const int edge = map_.edge_id(index);
+  const bool has_line = options_.use_line_stereo && edge >= 0 &&
+                        edge < static_cast<int>(lines_in_cur.size()) && lines_in_cur[edge].matched;
+  if (has_line) {
+    ++stats->line_attempts;
+    status = ObserveOnLine(index, geometry, lines_in_cur[edge], idepth_min, idepth_max, &current,
+                           patch_status == StereoStatus::kOk ? &patch : nullptr, &observation);
+    if (status == StereoStatus::kOk) {
+      ++stats->line_ok;
+      if (options_.line_stereo_refine_ssd && patch_status == StereoStatus::kOk) {
+        const double range = options_.search_sigmas * std::sqrt(observation.idepth_var);
+        StereoObservation refined;
+        if (SearchEpipolarSsd(current, geometry, patch, pixel,
+                              std::max(idepth_min, observation.idepth - range),
+                              std::min(idepth_max, observation.idepth + range), options_,
+                              &refined) == StereoStatus::kOk) {
+          observation = refined;
+          ++stats->line_refined;
+        }
+      }
+    } else if (status == StereoStatus::kLineIllConditioned) {
+      ++stats->line_fallback;
+    } else {
+      ++stats->line_rejected;
+      stats->line_out_of_range += status == StereoStatus::kLineOutOfRange;
+      return;
+    }
+  }
+  if (status != StereoStatus::kOk) {
+    if (patch_status != StereoStatus::kOk) return;
+    ++stats->ssd_attempts;
+    status = SearchEpipolarSsd(current, geometry, patch, pixel, idepth_min, idepth_max, options_,
+                               &observation);
+    if (status == StereoStatus::kNotUnique || status == StereoStatus::kLargeError) {
+      map_.AddBlacklist(index);
+    }
+    if (status != StereoStatus::kOk) return;
+    ++stats->ssd_ok;
+  }
+  // Every stereo observation of the pixel (SSD or line-guided) shares part of its error with the
+  // others (options.stereo_error_correlation, SemiDenseDepthMap::Fuse); a line-guided one also
+  // its keyframe edge's error, shared_idepth_var.
+  const double rho = options_.stereo_error_correlation;
+  const double correlation =
+      rho + (1.0 - rho) * observation.shared_idepth_var / observation.idepth_var;
+  if (valid) {
+    if (map_.Fuse(index, observation.idepth, observation.idepth_var, correlation, options_)) {
+      ++stats->fused;
+    } else {
+      ++stats->outliers;
+    }
+  } else {
+    map_.Set(index, observation.idepth, observation.idepth_var, options_.validity_initial,
+             std::sqrt(correlation * observation.idepth_var));
+    map_.CountObservation(index);
+    ++stats->created;
+  }
+}
+
+FrameUpdateStats DepthMapper::UpdateWithFrame(const cv::Mat& image, const SE3& cur_from_ref,
+                                              const std::vector<MatchedLine>& lines_in_cur,
+                                              const Matrix6d& pose_covariance) {
+  if (image.empty() || image.cols != map_.width() || image.rows != map_.height() ||
+      image.channels() != 1) {
+    throw std::invalid_argument(
+        "DepthMapper::UpdateWithFrame: frame must be a gray image of the keyframe's size");
+  }
+  FrameUpdateStats stats;
+  const ImagePyramid current(image, 1);
+  const EpipolarGeometry geometry(camera_, cur_from_ref, pose_covariance);
+  if (!(cur_from_ref.translation().norm() > 0.0)) return stats;  // no baseline, no stereo
+  // Matches whose line most of the edge's hypotheses contradict are left out for this frame; the
+  // edge's pixels then search like pixels without a line.
+  const std::vector<MatchedLine>* lines = &lines_in_cur;
+  std::vector<MatchedLine> kept;
+  if (options_.use_line_stereo && options_.line_match_max_outside_fraction < 1.0) {
+    kept = lines_in_cur;
+    const std::vector<char> inconsistent = InconsistentLineMatches(geometry, kept);
+    for (size_t e = 0; e < kept.size(); ++e) {
+      if (!inconsistent[e]) continue;
+      kept[e].matched = false;
+      stats.dropped_line_matches.push_back(static_cast<int>(e));
+    }
+    lines = &kept;
+  }
+  // Two passes (edge pixels, then the rest) so that each is timed on its own.
+  for (int pass = 0; pass < 2; ++pass) {
+    const auto start = WallClock::now();
+    for (int i = 0; i < map_.num_pixels(); ++i) {
+      if (!map_.candidate(i) || (map_.edge_id(i) >= 0) != (pass == 0)) continue;
+      if (map_.blacklist(i) >= options_.blacklist_threshold) continue;
+      if (pass == 0) ++stats.num_edge_pixels;
+      UpdatePixel(i, current, geometry, *lines, &stats);
+    }
+    (pass == 0 ? stats.edge_stereo_ms : stats.other_stereo_ms) = MsSince(start);
+  }
+  if (options_.regularize) {
+    stats.removed = RemoveIsolatedHypotheses(options_, &map_);
+    stats.filled = FillHoles(options_, &map_);
+  }
+  return stats;
+}
+
+LineDepthFusionStats DepthMapper::FuseLineDepths(const std::vector<KeyframeLine>& lines) {
+  LineDepthFusionStats stats;
+  std::map<int, const KeyframeLine*> line_of_edge;
+  for (const KeyframeLine& line : lines) line_of_edge[line.edge_id] = &line;
+  const double max_miss_ratio = kLineDepthMissPx / std::max(camera_.fx, camera_.fy);
+  for (int i = 0; i < map_.num_pixels(); ++i) {
+    if (!map_.valid(i) || map_.edge_id(i) < 0) continue;
+    const auto it = line_of_edge.find(map_.edge_id(i));
+    if (it == line_of_edge.end()) continue;
+    ++stats.pixels;
+    const Eigen::Vector2d pixel(i % map_.width(), i / map_.width());
+    double idepth, idepth_var;
+    if (!RayLineInverseDepthAndVariance(camera_, pixel, *it->second, max_miss_ratio, &idepth,
+                                        &idepth_var) ||
+        !(idepth_var > 0.0)) {
+      ++stats.skipped;
+      continue;
+    }
+    // The edge BA's line depth is independent of the pixel's stereo observations.
+    if (map_.Fuse(i, idepth, idepth_var, 0.0, options_)) {
+      ++stats.fused;
+    } else {
+      ++stats.outliers;
+    }
+  }
+  return stats;
+}
+
+SemiDenseDepthMap DepthMapper::RegularizedMap(bool smooth, bool line_regularize,
+                                              LineRegularizationStats* stats) const {
+  SemiDenseDepthMap result;
+  if (smooth) {
+    SmoothDepthMap(map_, options_, &result);
+  } else {
+    result = map_;
+  }
+  if (line_regularize && !edges_.lines.empty()) {
+    const LineRegularizer regularizer(options_);
+    const LineRegularizationStats line_stats = regularizer.Regularize(camera_, edges_, &result);
+    if (stats) *stats = line_stats;
+  }
+  return result;
+}
+
+PropagationStats DepthMapper::PropagateToNewKeyframe(const cv::Mat& image, const EdgeTrace& edges,
+                                                     const SE3& new_from_old,
+                                                     const AffineBrightness& brightness) {
+  const SemiDenseDepthMap old_map =
+      RegularizedMap(options_.regularize, options_.line_regularization);
+  const ImagePyramid old_keyframe = keyframe_;
+  SetKeyframe(image, edges);
+  PropagationStats stats;
+  map_ = PropagateDepthMap(old_map, old_keyframe, keyframe_, edges_.id_map, camera_, new_from_old,
+                           options_, &stats, brightness);
+  return stats;
+}
+
+}  // namespace pldvo

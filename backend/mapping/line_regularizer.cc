@@ -1,0 +1,187 @@
+#include "backend/mapping/line_regularizer.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace pldvo {
+namespace {
+
+// Weighted least squares of d = x^T c over the selected samples; false when degenerate.
+bool SolveWeighted(const std::vector<Eigen::Vector2d>& rays, const std::vector<double>& idepths,
+                   const std::vector<double>& vars, const std::vector<uint8_t>& use,
+                   Eigen::Vector2d* coeffs, Eigen::Matrix2d* cov) {
+  Eigen::Matrix2d h = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d g = Eigen::Vector2d::Zero();
+  for (size_t i = 0; i < rays.size(); ++i) {
+    if (!use[i]) continue;
+    const double w = 1.0 / vars[i];
+    h += w * rays[i] * rays[i].transpose();
+    g += w * idepths[i] * rays[i];
+  }
+  // Relative conditioning: the rays of a short edge are nearly parallel.
+  const double det = h.determinant();
+  if (!(det > 1e-12 * h.trace() * h.trace())) return false;
+  *cov = h.inverse();
+  *coeffs = *cov * g;
+  return true;
+}
+
+int SelectInliers(const std::vector<Eigen::Vector2d>& rays, const std::vector<double>& idepths,
+                  const std::vector<double>& vars, const std::vector<uint8_t>& valid,
+                  const Eigen::Vector2d& coeffs, double gate, std::vector<uint8_t>* inlier,
+                  double* chi2_sum) {
+  int count = 0;
+  double sum = 0.0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    (*inlier)[i] = 0;
+    if (!valid[i]) continue;
+    const double r = idepths[i] - rays[i].dot(coeffs);
+    const double m2 = r * r / vars[i];
+    if (m2 < gate) {
+      (*inlier)[i] = 1;
+      ++count;
+      sum += m2;
+    }
+  }
+  if (chi2_sum) *chi2_sum = sum;
+  return count;
+}
+
+}  // namespace
+
+Eigen::Vector3d LineFit::PointInRef() const {
+  // Nearest point of c^T p = 1 to the origin: p = c / |c|^2.
+  const Eigen::Vector2d p = coeffs / coeffs.squaredNorm();
+  return p.x() * e_x + p.y() * e_y;
+}
+
+Eigen::Vector3d LineFit::DirectionInRef() const {
+  const Eigen::Vector2d d = Eigen::Vector2d(-coeffs.y(), coeffs.x()).normalized();
+  return d.x() * e_x + d.y() * e_y;
+}
+
+LineRegularizer::LineRegularizer(const MappingOptions& options) : options_(options) {
+  const std::string error = options.Check();
+  if (!error.empty()) throw std::invalid_argument(error);
+}
+
+LineFit LineRegularizer::FitEdge(const PinholeCamera& camera, const Eigen::Vector3d& line_in_ref,
+                                 const std::vector<Eigen::Vector2i>& pixels,
+                                 const SemiDenseDepthMap& map, std::mt19937* rng) const {
+  LineFit fit;
+  const size_t n = pixels.size();
+  fit.inlier.assign(n, 0);
+  const Eigen::Vector3d normal_unscaled = camera.K().transpose() * line_in_ref;
+  if (!(normal_unscaled.norm() > 0.0)) return fit;
+  fit.normal = normal_unscaled.normalized();
+
+  std::vector<Eigen::Vector3d> rays3(n);
+  std::vector<uint8_t> valid(n, 0);
+  std::vector<double> idepths(n, 0.0), vars(n, 1.0);
+  std::vector<int> valid_index;
+  valid_index.reserve(n);
+  Eigen::Vector3d mean_ray = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2i& p = pixels[i];
+    rays3[i] = camera.Unproject(p.cast<double>());
+    mean_ray += rays3[i].normalized();
+    if (p.x() < 0 || p.y() < 0 || p.x() >= map.width() || p.y() >= map.height()) continue;
+    const int index = map.Index(p.x(), p.y());
+    if (!map.valid(index) || !(map.idepth_var(index) > 0.f)) continue;
+    valid[i] = 1;
+    idepths[i] = map.idepth(index);
+    vars[i] = map.idepth_var(index);
+    valid_index.push_back(static_cast<int>(i));
+  }
+  fit.num_used = static_cast<int>(valid_index.size());
+  if (fit.num_used < options_.line_min_pixels) return fit;
+  Eigen::Vector3d e_y = mean_ray - mean_ray.dot(fit.normal) * fit.normal;
+  if (!(e_y.norm() > 1e-9)) return fit;
+  fit.e_y = e_y.normalized();
+  fit.e_x = fit.e_y.cross(fit.normal);
+  std::vector<Eigen::Vector2d> rays(n);
+  for (size_t i = 0; i < n; ++i)
+    rays[i] = Eigen::Vector2d(fit.e_x.dot(rays3[i]), fit.e_y.dot(rays3[i]));
+
+  // RANSAC over pairs of valid pixels.
+  const double gate = options_.line_ransac_gate_chi2;
+  std::uniform_int_distribution<int> pick(0, fit.num_used - 1);
+  std::vector<uint8_t> inlier(n, 0);
+  int best_count = -1;
+  double best_chi2 = 0.0;
+  Eigen::Vector2d best_coeffs = Eigen::Vector2d::Zero();
+  for (int iteration = 0; iteration < options_.line_ransac_iterations; ++iteration) {
+    const int i = valid_index[pick(*rng)], j = valid_index[pick(*rng)];
+    if (i == j) continue;
+    Eigen::Matrix2d a;
+    a.row(0) = rays[i].transpose();
+    a.row(1) = rays[j].transpose();
+    if (!(std::abs(a.determinant()) > 1e-12 * a.squaredNorm())) continue;
+    const Eigen::Vector2d coeffs = a.inverse() * Eigen::Vector2d(idepths[i], idepths[j]);
+    double chi2 = 0.0;
+    const int count = SelectInliers(rays, idepths, vars, valid, coeffs, gate, &inlier, &chi2);
+    if (count > best_count || (count == best_count && chi2 < best_chi2)) {
+      best_count = count;
+      best_chi2 = chi2;
+      best_coeffs = coeffs;
+    }
+  }
+  if (best_count < 2) return fit;
+  Eigen::Vector2d coeffs = best_coeffs;
+  Eigen::Matrix2d cov;
+  for (int refit = 0; refit < 2; ++refit) {
+    SelectInliers(rays, idepths, vars, valid, coeffs, gate, &inlier, nullptr);
+    if (!SolveWeighted(rays, idepths, vars, inlier, &coeffs, &cov)) return fit;
+  }
+  fit.num_inliers = SelectInliers(rays, idepths, vars, valid, coeffs, gate, &inlier, nullptr);
+  const int min_inliers =
+      std::max(options_.line_min_pixels,
+               static_cast<int>(std::ceil(options_.line_min_inlier_ratio * fit.num_used)));
+  if (fit.num_inliers < min_inliers) return fit;
+  fit.ok = true;
+  fit.coeffs = coeffs;
+  fit.cov = cov;
+  fit.inlier = inlier;
+  return fit;
+}
+
+LineRegularizationStats LineRegularizer::Regularize(const PinholeCamera& camera,
+                                                    const EdgeTrace& edges,
+                                                    SemiDenseDepthMap* map) const {
+  LineRegularizationStats stats;
+  std::mt19937 rng(static_cast<uint32_t>(options_.line_ransac_seed));
+  for (const TracedLine& edge : edges.lines) {
+    if (edge.pixels.empty()) continue;
+    const LineFit fit = FitEdge(camera, edge.segment.line, edge.pixels, *map, &rng);
+    if (!fit.ok) {
+      if (fit.num_used > 0) ++stats.edges_rejected;
+      continue;
+    }
+    ++stats.edges_fitted;
+    for (size_t i = 0; i < edge.pixels.size(); ++i) {
+      const Eigen::Vector2i& p = edge.pixels[i];
+      if (p.x() < 0 || p.y() < 0 || p.x() >= map->width() || p.y() >= map->height()) continue;
+      const int index = map->Index(p.x(), p.y());
+      if (!map->valid(index)) continue;
+      if (!fit.inlier[i]) {
+        ++stats.pixels_rejected;
+        continue;
+      }
+      const Eigen::Vector3d ray = camera.Unproject(p.cast<double>());
+      const Eigen::Vector2d x(fit.e_x.dot(ray), fit.e_y.dot(ray));
+      const double idepth = x.dot(fit.coeffs);
+      if (!(idepth > 0.0)) continue;
+      // Conservative variance (see the header): the fully-correlated bound N x^T Cov(c) x, never
+      // above the pixel's own variance.
+      const double var =
+          std::min<double>(map->idepth_var(index), fit.num_inliers * x.dot(fit.cov * x));
+      map->SetIdepthAndVar(index, idepth, var);
+      ++stats.pixels_updated;
+    }
+  }
+  return stats;
+}
+
+}  // namespace pldvo

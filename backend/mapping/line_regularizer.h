@@ -1,0 +1,93 @@
+// 3D line regularisation of edge pixels (Yang & Scherer, ICRA 2017, Sec. V-B): the pixels of a
+// straight image edge back-project to points of one 3D line, so their inverse depths are refit
+// jointly.
+//
+// Frame F (eq. 11): the plane through the keyframe centre and the edge has the normal
+// n = K^T l1 / |K^T l1| (l1 the edge's keyframe line). F has its origin at the centre, e_y the
+// mean viewing ray of the edge projected into the plane, e_x = e_y x n. A pixel x_i with ray
+// r_i = K^-1 (x_i; 1) and inverse depth d_i is the point P_i = r_i / d_i with F coordinates
+// (X_i, Y_i) = (a_i, b_i) / d_i, (a_i, b_i) = (e_x . r_i, e_y . r_i) (the ray's in-plane part;
+// the component along n, at most the pixel's distance to l1, is dropped).
+//
+// Line model: a 2D line of F not through the centre is c1 X + c2 Y = 1 (equivalently the
+// paper's Y = beta0 + beta1 X with beta0 = 1/c2, beta1 = -c1/c2). Along the ray of pixel i it
+// predicts d_i = c1 a_i + c2 b_i: linear in c, and the pixel's noise lives along its ray, i.e. in
+// d_i with variance V_i. Hence
+//   Mahalanobis distance (eq. 12):  m_i^2 = (d_i - x_i^T c)^2 / V_i,  x_i = (a_i, b_i),
+//   weighted least squares (eq. 13): c = (X^T W X)^-1 X^T W Y,  X rows x_i^T, Y_i = d_i,
+//                                    W = diag(1 / V_i),   Cov(c) = (X^T W X)^-1,
+// exact with the true inverse variances as weights (no iteration). RANSAC draws two pixels,
+// solves for c, counts inliers with m_i^2 < gate, then refits on the inliers (twice: the
+// refined line re-selects its inliers once).
+//
+// Update: every inlier pixel gets the line's prediction d_i' = x_i^T c. This replaces, not fuses,
+// the pixel's estimate: the line was computed from it, so a product with the old Gaussian would
+// count the same data twice. Outliers keep their values. Variance: x_i^T Cov(c) x_i is the
+// variance of the fitted line at pixel i only if the pixels' errors are independent; along an
+// edge they are not (line-guided pixels share the matched line's error, photometric pixels
+// overlapping SSD patches), and with x_i^T Cov(c) x_i (~ V / N) the measured NEES of the
+// regularised pixels was 20-70 (docs/mapping.md). We therefore use the fully-correlated bound
+//   V_i' = min(V_i, N_inliers x_i^T Cov(c) x_i)
+// (if all N errors were identical the fit would be as uncertain as one pixel), which never
+// claims more certainty than the pixel had. The regularisation is applied to a copy of the filter
+// state (DepthMapper::RegularizedMap), never fed back into the EKF.
+#ifndef PLDVO_BACKEND_MAPPING_LINE_REGULARIZER_H_
+#define PLDVO_BACKEND_MAPPING_LINE_REGULARIZER_H_
+
+#include <Eigen/Core>
+#include <random>
+#include <vector>
+
+#include "backend/mapping/mapping_options.h"
+#include "backend/mapping/semi_dense_depth_map.h"
+#include "core/pinhole_camera.h"
+#include "frontend/edge_tracer.h"
+
+namespace pldvo {
+
+// The fit of one edge.
+struct LineFit {
+  bool ok = false;
+  Eigen::Vector2d coeffs = Eigen::Vector2d::Zero();  // c: c1 X + c2 Y = 1 in F
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();     // Cov(c) = (X^T W X)^-1
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // plane normal n (keyframe frame)
+  Eigen::Vector3d e_x = Eigen::Vector3d::Zero();     // F's axes in the keyframe frame
+  Eigen::Vector3d e_y = Eigen::Vector3d::Zero();
+  int num_used = 0;  // valid pixels the fit saw
+  int num_inliers = 0;
+  std::vector<uint8_t> inlier;  // per input pixel (0 also for invalid pixels)
+
+  // The fitted 3D line in the keyframe frame: the point nearest the centre and the direction.
+  Eigen::Vector3d PointInRef() const;
+  Eigen::Vector3d DirectionInRef() const;
+};
+
+struct LineRegularizationStats {
+  int edges_fitted = 0;
+  int edges_rejected = 0;  // too few valid pixels or inliers, or degenerate
+  int pixels_updated = 0;
+  int pixels_rejected = 0;  // outliers of fitted edges
+};
+
+class LineRegularizer {
+ public:
+  // Throws std::invalid_argument when options.Check() fails.
+  explicit LineRegularizer(const MappingOptions& options);
+
+  // Fits the edge with keyframe line `line_in_ref` (l1, a^2 + b^2 = 1) through `pixels` using the
+  // valid hypotheses of `map`.
+  LineFit FitEdge(const PinholeCamera& camera, const Eigen::Vector3d& line_in_ref,
+                  const std::vector<Eigen::Vector2i>& pixels, const SemiDenseDepthMap& map,
+                  std::mt19937* rng) const;
+
+  // Fits every traced edge and updates its inliers in `map` (see the header comment).
+  LineRegularizationStats Regularize(const PinholeCamera& camera, const EdgeTrace& edges,
+                                     SemiDenseDepthMap* map) const;
+
+ private:
+  MappingOptions options_;
+};
+
+}  // namespace pldvo
+
+#endif  // PLDVO_BACKEND_MAPPING_LINE_REGULARIZER_H_

@@ -1,0 +1,249 @@
+#include "backend/odometry/mapping_worker.h"
+
+#include <glog/logging.h>
+
+#include <algorithm>
+#include <chrono>
+#include <exception>
+#include <utility>
+
+#include "backend/odometry/reference_builder.h"
+#include "core/wall_clock.h"
+
+namespace pldvo {
+
+MappingWorker::MappingWorker(const PinholeCamera& camera, const MappingOptions& options,
+                             bool parallel, int max_pending_updates, bool wait_when_behind,
+                             int inline_lag)
+    : camera_(camera),
+      options_(options),
+      parallel_(parallel),
+      max_pending_updates_(std::max(1, max_pending_updates)),
+      wait_when_behind_(wait_when_behind),
+      inline_lag_(std::max(0, inline_lag)),
+      mapper_(camera, options) {
+  if (parallel_) thread_ = std::thread(&MappingWorker::ThreadLoop, this);
+}
+
+MappingWorker::~MappingWorker() {
+  if (thread_.joinable()) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    job_ready_.notify_all();
+    thread_.join();
+  }
+}
+
+double MappingWorker::Submit(MappingJob job) {
+  if (!parallel_) {
+    if (job.kind == MappingJob::Kind::kUpdate) {
+      held_back_.push_back(std::move(job));
+      while (static_cast<int>(held_back_.size()) > inline_lag_) RunOldestHeldBack();
+    } else {
+      Flush();
+      Run(job);
+    }
+    return 0.0;
+  }
+  double wait_ms = 0.0;
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    auto pending_updates = [&] {
+      int pending = 0;
+      for (const MappingJob& queued : queue_) pending += queued.kind == MappingJob::Kind::kUpdate;
+      return pending;
+    };
+    if (job.kind == MappingJob::Kind::kUpdate && pending_updates() >= max_pending_updates_) {
+      if (wait_when_behind_) {
+        const auto start = WallClock::now();
+        job_done_.wait(lock, [&] { return pending_updates() < max_pending_updates_; });
+        wait_ms = MsSince(start);
+      } else {
+        for (auto it = queue_.begin(); it != queue_.end(); ++it) {
+          if (it->kind == MappingJob::Kind::kUpdate) {
+            queue_.erase(it);
+            ++dropped_updates_;
+            break;
+          }
+        }
+      }
+    }
+    queue_.push_back(std::move(job));
+  }
+  job_ready_.notify_one();
+  return wait_ms;
+}
+
+std::shared_ptr<const KeyframeMap> MappingWorker::Latest() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return latest_;
+}
+
+std::shared_ptr<const KeyframeMap> MappingWorker::WaitForKeyframe(int keyframe_id) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  job_done_.wait(lock, [&] {
+    return (latest_ != nullptr && latest_->keyframe_id == keyframe_id) ||
+           failed_keyframe_id_ == keyframe_id || (queue_.empty() && !busy_);
+  });
+  return latest_;
+}
+
+void MappingWorker::RunOldestHeldBack() {
+  const MappingJob job = std::move(held_back_.front());
+  held_back_.pop_front();
+  Run(job);
+}
+
+void MappingWorker::Flush() {
+  if (!parallel_) {
+    while (!held_back_.empty()) RunOldestHeldBack();
+    return;
+  }
+  std::unique_lock<std::mutex> lock(mutex_);
+  job_done_.wait(lock, [&] { return queue_.empty() && !busy_; });
+}
+
+std::vector<double> MappingWorker::JobTimesMs() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return job_ms_;
+}
+
+double MappingWorker::TakeRecentJobMs() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const double ms = recent_job_ms_;
+  recent_job_ms_ = 0.0;
+  return ms;
+}
+
+int MappingWorker::dropped_updates() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return dropped_updates_;
+}
+
+int MappingWorker::failed_jobs() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return failed_jobs_;
+}
+
+int MappingWorker::line_depths_fused() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return line_depths_fused_;
+}
+
+int MappingWorker::line_depth_outliers() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return line_depth_outliers_;
+}
+
+void MappingWorker::ThreadLoop() {
+  while (true) {
+    MappingJob job;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      job_ready_.wait(lock, [&] { return stop_ || !queue_.empty(); });
+      if (queue_.empty()) return;  // stop_ and nothing left
+      job = std::move(queue_.front());
+      queue_.pop_front();
+      busy_ = true;
+    }
+    Run(job);
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      busy_ = false;
+    }
+    job_done_.notify_all();
+  }
+}
+
+void MappingWorker::Publish(std::shared_ptr<KeyframeMap> keyframe_map) {
+  keyframe_map->reference = std::make_shared<const TrackingReference>(BuildReferencePoints(
+      *keyframe_map->map, keyframe_levels_, camera_, options_.max_reference_points,
+      options_.edge_foot_points ? mapper_.keyframe_lines() : std::vector<Eigen::Vector3d>()));
+  keyframe_map->mean_idepth = MeanInverseDepth(*keyframe_map->map);
+  keyframe_map->num_points =
+      keyframe_map->reference->levels.empty()
+          ? 0
+          : static_cast<int>(keyframe_map->reference->levels[0].points.size());
+  std::lock_guard<std::mutex> lock(mutex_);
+  latest_ = std::move(keyframe_map);
+}
+
+void MappingWorker::Run(const MappingJob& job) {
+  const auto start = WallClock::now();
+  try {
+    auto published = std::make_shared<KeyframeMap>();
+    switch (job.kind) {
+      case MappingJob::Kind::kInitialize:
+        if (!job.depth.empty()) {
+          mapper_.InitializeKeyframeFromDepth(job.image, job.edges, job.depth,
+                                              job.depth_idepth_var);
+        } else {
+          mapper_.InitializeKeyframe(job.image, job.edges);
+          published->random_init = true;
+        }
+        keyframe_levels_ = ImagePyramid(job.image, job.num_levels);
+        keyframe_id_ = job.keyframe_id;
+        num_updates_ = 0;
+        break;
+      case MappingJob::Kind::kUpdate:
+        if (job.keyframe_id != keyframe_id_) return;  // for a keyframe no longer current
+        mapper_.UpdateWithFrame(InReferenceBrightness(job.image, job.brightness), job.cur_from_kf,
+                                job.lines_in_cur, job.pose_covariance);
+        ++num_updates_;
+        break;
+      case MappingJob::Kind::kLineDepths: {
+        if (job.keyframe_id != keyframe_id_) return;  // for a keyframe no longer current
+        const LineDepthFusionStats stats = mapper_.FuseLineDepths(job.line_depths);
+        std::lock_guard<std::mutex> lock(mutex_);
+        line_depths_fused_ += stats.fused;
+        line_depth_outliers_ += stats.outliers;
+        // Often published right after the keyframe switch, before the odometry has read it: keep
+        // what the switch reported (retired map, propagation, random init).
+        if (latest_ != nullptr && latest_->keyframe_id == keyframe_id_) {
+          published->retired_map = latest_->retired_map;
+          published->retired_keyframe_id = latest_->retired_keyframe_id;
+          published->propagation = latest_->propagation;
+          published->random_init = latest_->random_init;
+        }
+        break;
+      }
+      case MappingJob::Kind::kNewKeyframe: {
+        if (job.keep_retired_map) {
+          published->retired_map = std::make_shared<const SemiDenseDepthMap>(
+              mapper_.RegularizedMap(options_.regularize, options_.line_regularization));
+          published->retired_keyframe_id = keyframe_id_;
+        }
+        published->propagation =
+            mapper_.PropagateToNewKeyframe(job.image, job.edges, job.new_from_old, job.brightness);
+        if (mapper_.depth_map().CountValid() < job.min_propagated_points) {
+          mapper_.InitializeKeyframe(job.image, job.edges);
+          published->random_init = true;
+        }
+        keyframe_levels_ = ImagePyramid(job.image, job.num_levels);
+        keyframe_id_ = job.keyframe_id;
+        num_updates_ = 0;
+        break;
+      }
+    }
+    published->keyframe_id = keyframe_id_;
+    published->num_updates = num_updates_;
+    published->map = std::make_shared<const SemiDenseDepthMap>(
+        mapper_.RegularizedMap(options_.regularize, options_.line_regularization));
+    Publish(std::move(published));
+  } catch (const std::exception& e) {
+    LOG(WARNING) << "mapping job for frame " << job.frame_index << " failed: " << e.what();
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++failed_jobs_;
+    if (job.kind == MappingJob::Kind::kInitialize || job.kind == MappingJob::Kind::kNewKeyframe) {
+      failed_keyframe_id_ = job.keyframe_id;
+    }
+  }
+  const double ms = MsSince(start);
+  std::lock_guard<std::mutex> lock(mutex_);
+  job_ms_.push_back(ms);
+  recent_job_ms_ += ms;
+}
+
+}  // namespace pldvo

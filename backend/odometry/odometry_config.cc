@@ -1,0 +1,70 @@
+#include "backend/odometry/odometry_config.h"
+
+#include <cmath>
+
+namespace pldvo {
+
+std::string KeyframeOptions::Check() const {
+  if (!(max_relative_distance > 0.0)) return "max_relative_distance must be > 0";
+  if (!(min_overlap >= 0.0 && min_overlap <= 1.0)) return "min_overlap must be in [0, 1]";
+  if (min_frames < 1) return "min_frames must be >= 1";
+  if (max_frames < 0) return "max_frames must be >= 0";
+  return "";
+}
+
+std::string OdometryOptions::Check() const {
+  if (num_levels < 1 || num_levels > 8) return "num_levels must be in [1, 8]";
+  if (!(line_outlier_px >= 0.0)) return "line_outlier_px must be >= 0";
+  if (!(line_prior_gate_px >= 0.0)) return "line_prior_gate_px must be >= 0";
+  if (!(retry_rms_ratio >= 1.0)) return "retry_rms_ratio must be >= 1";
+  if (!(alternative_rotation_deg > 0.0 && alternative_rotation_deg < 45.0)) {
+    return "alternative_rotation_deg must be in (0, 45)";
+  }
+  if (reinit_after_lost < 1) return "reinit_after_lost must be >= 1";
+  if (reinit_min_points < 0) return "reinit_min_points must be >= 0";
+  if (mapping_queue_size < 1) return "mapping_queue_size must be >= 1";
+  if (inline_mapping_lag < 0) return "inline_mapping_lag must be >= 0";
+  if (!(init_depth_idepth_var >= 0.0)) return "init_depth_idepth_var must be >= 0";
+  if (bootstrap_passes < 1) return "bootstrap_passes must be >= 1";
+  if (!(bootstrap_idepth_var > 0.0) || !std::isfinite(bootstrap_idepth_var)) {
+    return "bootstrap_idepth_var must be positive and finite";
+  }
+  if (bootstrap_passes > 1 && init_depth_idepth_var > 0.0) {
+    return "bootstrap_passes > 1 refines the monocular start and cannot be combined with "
+           "init_depth_idepth_var";
+  }
+  if (!(two_view_min_parallax_deg > 0.0 && two_view_min_parallax_deg < 90.0)) {
+    return "two_view_min_parallax_deg must be in (0, 90)";
+  }
+  if (two_view_min_inliers < 8) return "two_view_min_inliers must be >= 8";
+  if (two_view_max_frames < 1) return "two_view_max_frames must be >= 1";
+  if (two_view_bootstrap && (bootstrap_passes > 1 || init_depth_idepth_var > 0.0)) {
+    return "two_view_bootstrap replaces the monocular start and cannot be combined with "
+           "bootstrap_passes > 1 or init_depth_idepth_var";
+  }
+  return "";
+}
+
+std::string OutputOptions::Check() const {
+  if (iteration_images_every < 0) return "iteration_images_every must be >= 0";
+  if (!(discontinuity_rel_step > 0.0)) return "discontinuity_rel_step must be > 0";
+  if (discontinuity_radius_px < 0) return "discontinuity_radius_px must be >= 0";
+  return "";
+}
+
+std::string OdometryConfig::Check() const {
+  const std::pair<const char*, std::string> sections[] = {
+      {"dataset", dataset.Check()},     {"lines", lines.Check()},
+      {"tracking", tracking.Check()},   {"mapping", mapping.Check()},
+      {"keyframes", keyframes.Check()}, {"odometry", odometry.Check()},
+      {"output", output.Check()},       {"backend", backend.Check()}};
+  for (const auto& [name, error] : sections) {
+    if (!error.empty()) return std::string(name) + ": " + error;
+  }
+  if (tracking.finest_level >= odometry.num_levels) {
+    return "tracking.finest_level must be < odometry.num_levels";
+  }
+  return "";
+}
+
+}  // namespace pldvo

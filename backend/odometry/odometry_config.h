@@ -1,0 +1,291 @@
+// THE configuration of the odometry (`pldvo run`): one typed struct tree with the VisitFields
+// pattern (core/options.h), so that one YAML file (experiments/configs/*.yaml), `--set key=value`
+// overrides, the effective config.yaml of a run and the key table of docs/configuration.md all
+// come from the same fields. Sections:
+//   dataset    DatasetOptions (format, camera, ground_truth, normalize_exposure)
+//   lines      LineFrontendOptions (detection, merging, LBD, matching, edge tracing)
+//   tracking   TrackingOptions (solver, problem builder + weighting policy, levels, loss of track)
+//   mapping    MappingOptions (semi-dense depth filter, line-guided stereo, propagation)
+//   keyframes  KeyframeOptions (when a tracked frame becomes the new keyframe)
+//   odometry   OdometryOptions (pyramid, line frontend on/off, alternative initial guesses,
+//              lost-tracking recovery, threading)
+//   output     OutputOptions (iteration images, keyframe depth PNGs, PLY point clouds)
+//   backend    BackendOptions: edge_ba = EdgeBAOptions (windowed edge bundle adjustment)
+// Defaults are the paper's configuration (experiments/configs/points_lines.yaml is empty of
+// overrides on purpose); docs/configuration.md lists every key.
+#ifndef PLDVO_BACKEND_ODOMETRY_ODOMETRY_CONFIG_H_
+#define PLDVO_BACKEND_ODOMETRY_ODOMETRY_CONFIG_H_
+
+#include <string>
+
+#include "backend/edge_ba/edge_ba_options.h"
+#include "backend/mapping/mapping_options.h"
+#include "backend/tracking/tracker.h"
+#include "core/dataset.h"
+#include "core/options.h"
+#include "frontend/line_frontend_options.h"
+
+namespace pldvo {
+
+// When the current frame becomes a new keyframe (checked after every successfully tracked frame;
+// LSD-SLAM / semi-dense VO criteria). The distance criterion is scale-free: the translation from
+// the keyframe times the keyframe map's mean inverse depth, i.e. the baseline relative to the
+// mean scene depth, so it means the same for any (arbitrary) monocular scale.
+struct KeyframeOptions {
+  // New keyframe when |t_cur_from_kf| * mean_idepth exceeds this (0.1: a baseline of 10% of the
+  // mean scene depth).
+  double max_relative_distance = 0.1;
+  // New keyframe when fewer than this fraction of the keyframe's level-0 points reproject inside
+  // the current image.
+  double min_overlap = 0.7;
+  // No new keyframe before this many frames were tracked against the current one (the depth
+  // filter needs a few stereo observations before its map is propagated).
+  int min_frames = 3;
+  // Always a new keyframe after this many tracked frames (0 = no limit).
+  int max_frames = 0;
+
+  template <class Visitor>
+  void VisitFields(Visitor& v) {
+    v.Field("max_relative_distance", &max_relative_distance,
+            "New keyframe when |t_cur_from_kf| * mean inverse depth exceeds this (default 0.1).");
+    v.Field("min_overlap", &min_overlap,
+            "New keyframe when fewer of the keyframe's points reproject inside the frame "
+            "(default 0.7).");
+    v.Field("min_frames", &min_frames,
+            "Frames tracked against a keyframe before another may be created (default 3).");
+    v.Field("max_frames", &max_frames,
+            "New keyframe after this many tracked frames; 0 = no limit (default 0).");
+  }
+  std::string Check() const;
+};
+
+struct OdometryOptions {
+  // Pyramid levels of the current frames and of the tracking reference (level 0 = full
+  // resolution). tracking.coarsest_level is clamped to num_levels - 1.
+  int num_levels = 5;
+  // Run the line frontend (detection, LBD, matching, edge tracing). Off: no point-to-line
+  // residuals, no line-guided stereo, no 3D line regularisation (the semi-dense VO baseline).
+  bool use_lines = true;
+  // Matching prediction: keyframe segments are mapped into the frame with the homography of the
+  // predicted pose and a fronto-parallel plane at the keyframe's mean inverse depth.
+  bool predict_line_matches = true;
+  // Line-match verification after tracking: a matched line whose edge points (level 0),
+  // reprojected with the tracked pose, lie at a median distance above this many pixels from it is
+  // a wrong match (e.g. the neighbouring line of a repetitive pattern); such lines are unmatched
+  // and the frame is tracked again from the result. The same unmatched lines are withheld from
+  // the line-guided stereo. 0 = off.
+  double line_outlier_px = 2.0;
+  // The same check before tracking at the constant-velocity prior, with this looser gate (the
+  // prior is off by the acceleration since the last frame); 0 = off.
+  double line_prior_gate_px = 2.0;
+  // Alternative initial guesses (besides the constant-velocity prior) are tried when the result
+  // is lost, or when its final photometric RMS exceeds retry_rms_ratio times the running mean
+  // over recent tracked frames (backend/odometry/retry_trigger.h): zero motion since the last good
+  // frame, and that pose rotated by +-alternative_rotation_deg about the camera's x and y axes.
+  // The best non-lost result (most inlier rows at the finest level) wins.
+  bool try_alternatives = true;
+  double retry_rms_ratio = 1.5;
+  double alternative_rotation_deg = 2.0;
+  // Lost tracking: a lost frame gets the constant-velocity extrapolation of the last good pose
+  // (marked lost, not mapped). After this many consecutive lost frames the odometry
+  // re-initialises: the current frame becomes a keyframe at the extrapolated pose, with the old
+  // keyframe's map propagated to it, or a fresh random map when fewer than reinit_min_points
+  // hypotheses survive the propagation.
+  int reinit_after_lost = 3;
+  int reinit_min_points = 500;
+  // Mapping in its own thread (default). false: mapping runs on the caller's thread after each
+  // frame, deterministic (the tests).
+  bool parallel_mapping = true;
+  // parallel_mapping false: a frame's map update runs only after this many later frames were
+  // tracked, so the tracking sees a map that lags like the mapping thread's (0: the newest frame;
+  // with wait_for_mapping, once mapping is the bottleneck, the thread's schedule is a lag of
+  // mapping_queue_size + 1). Keyframe switches first run every held-back update, in order.
+  int inline_mapping_lag = 0;
+  // `pldvo run`: the per-image work of frame i + 1 (pyramid, line detection, merging and LBD;
+  // FramePreparer) runs on the loading thread while frame i is tracked. It is a pure function of
+  // the image, so results do not change; tracking_thread then leaves it out, and the frame period
+  // (`total`) is the slower of the two stages. It pays where a core is free: with inline mapping
+  // on textured frames; with the mapping thread on 2 cores the three threads share them and the
+  // frame period grows (docs/odometry.md, "Threading"). false: all of it on the tracking thread.
+  bool frontend_thread = false;
+  // Pending mapping updates kept when the mapping thread falls behind; older pending frames are
+  // dropped (counted). Keyframe creations are never dropped.
+  int mapping_queue_size = 2;
+  // When mapping_queue_size updates are pending, wait for the mapping thread instead of dropping
+  // the oldest: every tracked frame updates the map, so results do not depend on the machine's
+  // load (the wait is reported as `wait`). false: real-time behaviour, updates are dropped.
+  bool wait_for_mapping = true;
+  // Evaluation aid, off by default (monocular): initialise the first keyframe's map from the
+  // first frame's depth image (TUM layout: 16-bit PNG, metres x 5000) with this inverse-depth
+  // variance, which fixes the scale and removes the monocular initialisation; 0 = off.
+  double init_depth_idepth_var = 0.0;
+  // Bootstrap refinement (backend/odometry/bootstrap_refiner.h), monocular runs: before the run,
+  // this many passes minus one over the first keyframe's frames, each starting from the map the
+  // previous one ended with (the first from the random map); the run then starts from the last map
+  // with inverse-depth variance bootstrap_idepth_var, relative to a median inverse depth of 1 (also
+  // the variance of the two-view bootstrap's map, below).
+  // 1 = off (default).
+  int bootstrap_passes = 1;
+  double bootstrap_idepth_var = 0.05;
+  // Two-view bootstrap (backend/odometry/two_view_bootstrap.h), monocular runs: frame 0's map from
+  // the first frame k <= two_view_max_frames where two_view_min_inliers tracked corners triangulate
+  // (essential matrix) with a median parallax of two_view_min_parallax_deg, the poses of frames
+  // 1..k bundle-adjusted, and stereo with them; the run starts from it with bootstrap_idepth_var.
+  // Off by default (the random map); when it fails the run starts from the random map.
+  bool two_view_bootstrap = false;
+  double two_view_min_parallax_deg = 2.0;
+  int two_view_min_inliers = 50;
+  int two_view_max_frames = 60;
+  // Solver comparison (docs/tracking.md): every tracked frame's final tracking problem (the same
+  // reference, lines and initial pose) is solved a second time with this solver; its poses, RPE
+  // and time are reported beside the run's (summary.json `compare_solver`,
+  // trajectory_compare.txt) and do not influence the run. Not counted in tracking_thread.
+  enum class CompareSolver { kNone, kCeres, kGaussNewton };
+  CompareSolver compare_solver = CompareSolver::kNone;
+
+  template <class Visitor>
+  void VisitFields(Visitor& v) {
+    v.Field("num_levels", &num_levels, "Pyramid levels of frames and reference (default 5).");
+    v.Field("use_lines", &use_lines,
+            "Run the line frontend; false is the photometric semi-dense VO baseline.");
+    v.Field("predict_line_matches", &predict_line_matches,
+            "Gate line matching around the segments predicted by the pose prior.");
+    v.Field("line_outlier_px", &line_outlier_px,
+            "Unmatch lines whose edge points reproject at a median distance above this (px) "
+            "after tracking, and track again; 0 = off (default 2).");
+    v.Field("line_prior_gate_px", &line_prior_gate_px,
+            "Unmatch lines whose edge points reproject at a median distance above this (px) at "
+            "the pose prior, before tracking; 0 = off (default 2).");
+    v.Field("try_alternatives", &try_alternatives,
+            "Retry lost or high-residual frames from alternative initial guesses.");
+    v.Field("retry_rms_ratio", &retry_rms_ratio,
+            "Retry when the final photometric RMS exceeds this times the recent mean (1.5).");
+    v.Field("alternative_rotation_deg", &alternative_rotation_deg,
+            "Rotation of the alternative guesses about the camera x and y axes, deg (default 2).");
+    v.Field("reinit_after_lost", &reinit_after_lost,
+            "Consecutive lost frames before re-initialising at the current frame (default 3).");
+    v.Field("reinit_min_points", &reinit_min_points,
+            "Propagated hypotheses needed to keep the map on re-initialisation (default 500).");
+    v.Field("parallel_mapping", &parallel_mapping,
+            "Mapping in its own thread; false runs it inline (deterministic).");
+    v.Field("inline_mapping_lag", &inline_mapping_lag,
+            "parallel_mapping false: frames tracked before a frame's map update runs (default 0).");
+    v.Field("frontend_thread", &frontend_thread,
+            "pldvo run: prepare frame i + 1 (pyramid, lines, LBD) on the loading thread while "
+            "frame i is tracked (default false); results are unchanged.");
+    v.Field("mapping_queue_size", &mapping_queue_size,
+            "Pending mapping updates kept when mapping falls behind (default 2).");
+    v.Field("wait_for_mapping", &wait_for_mapping,
+            "Wait for the mapping thread when the queue is full instead of dropping updates.");
+    v.Field("init_depth_idepth_var", &init_depth_idepth_var,
+            "Evaluation aid: > 0 initialises the first keyframe from the dataset's depth image "
+            "with this inverse-depth variance, (1/m)^2; 0 = monocular random init (default).");
+    v.Field("bootstrap_passes", &bootstrap_passes,
+            "Monocular: passes over the first keyframe's frames, each re-estimating its map from "
+            "the previous pass's map; the run starts from the last (1 = off, default).");
+    v.Field("bootstrap_idepth_var", &bootstrap_idepth_var,
+            "Inverse-depth variance of a refined or two-view start map, median inverse depth 1 "
+            "(default 0.05).");
+    v.Field("two_view_bootstrap", &two_view_bootstrap,
+            "Monocular: frame 0's map from the two-view geometry of tracked corners and stereo "
+            "with the frames up to the second view; the run starts from it (default false).");
+    v.Field("two_view_min_parallax_deg", &two_view_min_parallax_deg,
+            "Two-view bootstrap: median parallax of the triangulated corners that makes a frame "
+            "the second view, deg (default 2).");
+    v.Field("two_view_min_inliers", &two_view_min_inliers,
+            "Two-view bootstrap: triangulated essential-matrix inliers needed (default 50).");
+    v.Field("two_view_max_frames", &two_view_max_frames,
+            "Two-view bootstrap: frames searched for the second view (default 60).");
+    v.Choice("compare_solver", &compare_solver,
+             ChoiceNames<CompareSolver>{{"none", CompareSolver::kNone},
+                                        {"ceres", CompareSolver::kCeres},
+                                        {"gauss_newton", CompareSolver::kGaussNewton}},
+             "Also solve every frame's tracking problem with this solver and report the "
+             "difference: none | ceres | gauss_newton (default none).");
+  }
+  std::string Check() const;
+};
+
+// What a run writes besides the trajectory (all off by default; see docs/odometry.md).
+struct OutputOptions {
+  // Tracking-iteration images (reprojected edge pixels over the current frame, the paper's
+  // Fig. 2) of every N-th frame; 0 = none.
+  int iteration_images_every = 0;
+  // The inverse-depth map of every keyframe as a colour PNG when the keyframe is retired.
+  bool keyframe_depth_png = false;
+  // The semi-dense points of every keyframe (world frame) as a PLY when it is retired.
+  bool keyframe_ply = false;
+  // Every retired keyframe's map against the dataset's depth image of its frame (tum layout with
+  // depth.txt: synthetic sequences, TUM RGB-D, ICL-NUIM), after a median scale alignment, one
+  // row per keyframe in OUT/keyframe_maps.csv and medians in summary.json. Costs one depth-image
+  // read per keyframe on the tracking thread.
+  bool keyframe_map_error = false;
+  // Its `continuous` columns leave out pixels within this many pixels of a GT inverse-depth step
+  // larger than discontinuity_rel_step between 4-neighbours (as `pldvo mapeval`).
+  double discontinuity_rel_step = 0.02;
+  int discontinuity_radius_px = 3;
+
+  template <class Visitor>
+  void VisitFields(Visitor& v) {
+    v.Field("iteration_images_every", &iteration_images_every,
+            "Write tracking-iteration images of every N-th frame; 0 = none (default 0).");
+    v.Field("keyframe_depth_png", &keyframe_depth_png,
+            "Write each keyframe's inverse-depth map as PNG (default false).");
+    v.Field("keyframe_ply", &keyframe_ply,
+            "Write each keyframe's semi-dense points as PLY (default false).");
+    v.Field("keyframe_map_error", &keyframe_map_error,
+            "Evaluate each keyframe's map against the dataset's depth image (scale-aligned) into "
+            "keyframe_maps.csv and summary.json (default false).");
+    v.Field("discontinuity_rel_step", &discontinuity_rel_step,
+            "keyframe_map_error: a GT inverse-depth step between neighbours larger than this "
+            "fraction is a discontinuity (default 0.02).");
+    v.Field("discontinuity_radius_px", &discontinuity_radius_px,
+            "keyframe_map_error: pixels this close to a discontinuity are not `continuous` "
+            "(default 3).");
+  }
+  std::string Check() const;
+};
+
+// Optimisation beside tracking (docs/edge_ba.md).
+struct BackendOptions {
+  EdgeBAOptions edge_ba;  // off by default
+
+  template <class Visitor>
+  void VisitFields(Visitor& v) {
+    v.Section("edge_ba", &edge_ba, "Windowed edge bundle adjustment over the newest keyframes.");
+  }
+  std::string Check() const { return edge_ba.Check(); }
+};
+
+struct OdometryConfig {
+  // Defaults of the sub-structs, except the line detector: EDLines (at 640x480 about 4x faster
+  // than LSD; measured in docs/odometry.md).
+  OdometryConfig() { lines.detector.method = LineDetectorOptions::Method::kEdLines; }
+
+  DatasetOptions dataset;
+  LineFrontendOptions lines;
+  TrackingOptions tracking;
+  MappingOptions mapping;
+  KeyframeOptions keyframes;
+  OdometryOptions odometry;
+  OutputOptions output;
+  BackendOptions backend;
+
+  template <class Visitor>
+  void VisitFields(Visitor& v) {
+    v.Section("dataset", &dataset, "Dataset reading (format, camera, ground truth, exposure).");
+    v.Section("lines", &lines, "Line frontend: detection, merging, LBD, matching, tracing.");
+    v.Section("tracking", &tracking, "Coarse-to-fine direct tracking against the keyframe.");
+    v.Section("mapping", &mapping, "Semi-dense keyframe depth filter with line-guided stereo.");
+    v.Section("keyframes", &keyframes, "Keyframe selection.");
+    v.Section("odometry", &odometry, "Pipeline, lost-tracking recovery and threading.");
+    v.Section("output", &output, "Optional outputs of `pldvo run`.");
+    v.Section("backend", &backend, "Optimisation beside tracking (edge bundle adjustment).");
+  }
+  // "" when valid, otherwise the first section and what is wrong there.
+  std::string Check() const;
+};
+
+}  // namespace pldvo
+
+#endif  // PLDVO_BACKEND_ODOMETRY_ODOMETRY_CONFIG_H_

@@ -1,0 +1,491 @@
+#include "backend/odometry/sequence_runner.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <future>
+#include <iomanip>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <utility>
+
+#include "backend/odometry/bootstrap_refiner.h"
+#include "backend/odometry/frame_preparer.h"
+#include "backend/odometry/odometry.h"
+#include "backend/odometry/solver_comparison.h"
+#include "backend/odometry/two_view_bootstrap.h"
+#include "core/config_io.h"
+#include "core/evaluation.h"
+#include "core/trajectory_io.h"
+#include "core/trajectory_svg.h"
+#include "core/wall_clock.h"
+
+namespace pldvo {
+namespace {
+
+// The per-frame timing columns, in timing.csv order; the summary's ms objects use the same keys.
+const char* const kTimingKeys[] = {
+    "load", "pyramid",   "detection", "description", "matching",        "tracing",
+    "wait", "reference", "tracking",  "mapping",     "tracking_thread", "total"};
+constexpr size_t kNumTimingKeys = std::size(kTimingKeys);
+using TimingRow = std::array<double, kNumTimingKeys>;
+
+TimingRow MakeTimingRow(const OdometryTiming& t, double load_ms, double total_ms) {
+  return {load_ms,          t.pyramid_ms,         t.detection_ms,
+          t.description_ms, t.matching_ms,        t.tracing_ms,
+          t.wait_ms,        t.reference_ms,       t.tracking_ms,
+          t.mapping_ms,     t.tracking_thread_ms, total_ms};
+}
+
+double Mean(const std::vector<double>& values) {
+  if (values.empty()) return 0.0;
+  double sum = 0.0;
+  for (double v : values) sum += v;
+  return sum / values.size();
+}
+
+nlohmann::json NumberOrNull(double value) {
+  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
+}
+
+class ProgressBar {
+ public:
+  ProgressBar(int total, bool enabled)
+      : total_(total), enabled_(enabled), start_(WallClock::now()) {}
+  void Update(int done, int lost) {
+    if (!enabled_) return;
+    const auto now = WallClock::now();
+    if (done < total_ && now - last_ < std::chrono::milliseconds(100)) return;
+    last_ = now;
+    const double seconds = std::chrono::duration<double>(now - start_).count();
+    const int width = 30;
+    const int filled = total_ > 0 ? width * done / total_ : width;
+    std::fprintf(stderr, "\r[%s%s] %d/%d  %.1f fps  lost %d ", std::string(filled, '#').c_str(),
+                 std::string(width - filled, '.').c_str(), done, total_,
+                 seconds > 0.0 ? done / seconds : 0.0, lost);
+    if (done == total_) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  }
+
+ private:
+  int total_;
+  bool enabled_;
+  WallClock::time_point start_;
+  WallClock::time_point last_;
+};
+
+// The line-by-line files of the run. Every write is flushed; a failed one (disk full, folder
+// removed) throws RunOutputError: its output could not be kept.
+class RunFiles {
+ public:
+  RunFiles(const std::string& out_dir, const std::string& dataset_label) : out_dir_(out_dir) {
+    trajectory_.open(out_dir + "/trajectory.txt");
+    timing_.open(out_dir + "/timing.csv");
+    if (!trajectory_ || !timing_) throw RunOutputError("cannot write into " + out_dir);
+    trajectory_ << "# pldvo run: timestamp tx ty tz qx qy qz qw (world_from_cam), dataset "
+                << dataset_label << "\n";
+    timing_ << "index,timestamp,status,keyframe_id,lines,matches,line_outliers,reference_points,"
+               "alternatives,iterations,final_rms,inlier_fraction,intensity_correlation,"
+               "brightness_a,brightness_b,pose_sigma_t,pose_sigma_r_deg";
+    for (const char* key : kTimingKeys) timing_ << "," << key << "_ms";
+    timing_ << "\n";
+    Flush(trajectory_, "trajectory.txt");
+    Flush(timing_, "timing.csv");
+  }
+
+  void AddPose(const StampedPose& pose) {
+    WriteTumLine(pose, trajectory_);
+    Flush(trajectory_, "trajectory.txt");
+  }
+
+  void AddTimingRow(const OdometryFrameResult& result, const TimingRow& row) {
+    // RMS sigma per axis of the tracked pose (tracking.pose_covariance; 0 without it).
+    const Matrix6d& pose_covariance = result.tracking.pose_covariance;
+    const double pose_sigma_t = std::sqrt(pose_covariance.topLeftCorner<3, 3>().trace() / 3.0);
+    const double pose_sigma_r_deg =
+        std::sqrt(pose_covariance.bottomRightCorner<3, 3>().trace() / 3.0) * 180.0 / M_PI;
+    const TrackingResult& tracking = result.tracking;
+    timing_ << result.index << "," << std::setprecision(17) << result.timestamp << ","
+            << FrameStatusName(result.status) << "," << result.keyframe_id << ","
+            << result.num_lines << "," << result.num_matches << "," << result.num_line_outliers
+            << "," << result.num_reference_points << "," << result.alternatives_tried << ","
+            << tracking.TotalIterations() << "," << std::setprecision(6) << tracking.final_rms
+            << "," << tracking.inlier_fraction << "," << tracking.intensity_correlation << ","
+            << tracking.brightness.a << "," << tracking.brightness.b << "," << pose_sigma_t << ","
+            << pose_sigma_r_deg;
+    for (double value : row) timing_ << "," << std::setprecision(4) << value;
+    timing_ << "\n";
+    Flush(timing_, "timing.csv");
+  }
+
+ private:
+  void Flush(std::ostream& file, const char* name) {
+    if (file.flush()) return;
+    throw RunOutputError("cannot write " + out_dir_ + "/" + name + ": " + std::strerror(errno) +
+                         "; stopping (lines written so far are kept)");
+  }
+
+  std::string out_dir_;
+  std::ofstream trajectory_;
+  std::ofstream timing_;
+};
+
+// Where the run starts: the config it runs with and frame 0's depth, from the bootstraps.
+struct InitialMap {
+  OdometryConfig run_config;
+  cv::Mat depth;             // frame 0's z-depth (empty: the dataset's or a random map)
+  nlohmann::json bootstrap;  // summary.json `bootstrap` (null when not run)
+  nlohmann::json two_view;   // summary.json `two_view_bootstrap` (null when not run)
+};
+
+// odometry.bootstrap_passes > 1 starts from the refined first map, odometry.two_view_bootstrap
+// from the map of the two-view geometry; either falls back to the random map, said so, when it
+// fails.
+InitialMap PrepareInitialMap(const Dataset& dataset, const OdometryConfig& config, int num_frames) {
+  InitialMap initial;
+  initial.run_config = config;
+  initial.run_config.odometry.bootstrap_passes = 1;
+  initial.run_config.odometry.two_view_bootstrap = false;  // the run starts from its map
+  if (config.odometry.bootstrap_passes > 1 && num_frames > 0) {
+    try {
+      const BootstrapRefinement refined = RefineBootstrap(dataset, config, num_frames);
+      initial.depth = refined.depth;
+      initial.run_config.odometry.init_depth_idepth_var = config.odometry.bootstrap_idepth_var;
+      initial.bootstrap = {
+          {"frames", refined.frames}, {"points", refined.points}, {"ms", refined.ms}};
+      std::cerr << "pldvo run: bootstrap refinement: " << refined.frames.size()
+                << " passes before the run, first keyframe hypotheses " << refined.points.back()
+                << ", " << static_cast<int>(refined.ms) << " ms\n";
+    } catch (const std::exception& e) {
+      std::cerr << "pldvo run: bootstrap refinement failed (" << e.what()
+                << "); the run starts from the random map\n";
+    }
+  }
+  if (config.odometry.two_view_bootstrap && num_frames > 0) {
+    try {
+      const TwoViewBootstrap two_view = BootstrapFromTwoViews(dataset, config, num_frames);
+      initial.depth = two_view.depth;
+      initial.run_config.odometry.init_depth_idepth_var = config.odometry.bootstrap_idepth_var;
+      initial.two_view = {
+          {"second_view", two_view.second_view}, {"tracks", two_view.tracks},
+          {"inliers", two_view.inliers},         {"parallax_deg", two_view.parallax_deg},
+          {"points", two_view.points},           {"ms", two_view.ms}};
+      std::cerr << "pldvo run: two-view bootstrap: second view frame " << two_view.second_view
+                << ", " << two_view.inliers << " of " << two_view.tracks
+                << " corners triangulated, median parallax " << two_view.parallax_deg << " deg, "
+                << two_view.points << " hypotheses, " << static_cast<int>(two_view.ms) << " ms\n";
+    } catch (const std::exception& e) {
+      std::cerr << "pldvo run: " << e.what() << "; the run starts from the random map\n";
+    }
+  }
+  return initial;
+}
+
+struct LoadedFrame {
+  Frame frame;
+  std::string error;  // non-empty when loading failed
+  double load_ms = 0.0;
+  // odometry.frontend_thread: the frame's per-image work, done on the loading thread.
+  std::optional<PreparedFrame> prepared;
+};
+
+// Loads frame `index` and, with a `preparer`, prepares it on the same (loading) thread. A frame
+// that is not a gray image of the camera's size is left unprepared: ProcessFrame reports it.
+LoadedFrame LoadFrame(const Dataset& dataset, int index, FramePreparer* preparer) {
+  LoadedFrame loaded;
+  const auto start = WallClock::now();
+  try {
+    loaded.frame = dataset.Load(index);
+    if (loaded.frame.image.empty()) loaded.error = "empty image " + loaded.frame.path;
+  } catch (const std::exception& e) {
+    loaded.error = e.what();
+  }
+  loaded.load_ms = MsSince(start);
+  const cv::Mat& image = loaded.frame.image;
+  const PinholeCamera& camera = dataset.camera();
+  if (preparer != nullptr && loaded.error.empty() && image.channels() == 1 &&
+      image.cols == camera.width && image.rows == camera.height) {
+    try {
+      loaded.prepared = preparer->Prepare(image);
+    } catch (const std::exception&) {
+      // Left unprepared: ProcessFrame(image) repeats the work and reports the failure.
+    }
+  }
+  return loaded;
+}
+
+// One frame through the odometry; a frame that fails to load or process is skipped, said so.
+OdometryFrameResult ProcessLoadedFrame(const Dataset& dataset, const InitialMap& initial,
+                                       const OdometryConfig& config, int i, LoadedFrame loaded,
+                                       Odometry* odometry) {
+  if (!loaded.error.empty()) {
+    std::cerr << (isatty(STDERR_FILENO) ? "\n" : "") << "pldvo run: frame " << i
+              << " skipped: " << loaded.error << "\n";
+    return odometry->SkipFrame(i, dataset.timestamp(i), loaded.error);
+  }
+  try {
+    cv::Mat depth;
+    if (i == 0 && !initial.depth.empty()) {
+      depth = initial.depth;
+    } else if (i == 0 && config.odometry.init_depth_idepth_var > 0.0) {
+      depth = dataset.LoadDepth(i);
+      if (depth.empty()) {
+        throw std::runtime_error(
+            "odometry.init_depth_idepth_var: the dataset has no depth image for frame 0");
+      }
+    }
+    return loaded.prepared.has_value()
+               ? odometry->ProcessFrame(i, loaded.frame.timestamp, std::move(*loaded.prepared),
+                                        depth)
+               : odometry->ProcessFrame(i, loaded.frame.timestamp, loaded.frame.image, depth);
+  } catch (const std::exception& e) {
+    std::cerr << "pldvo run: frame " << i << " (" << loaded.frame.path << ") skipped: " << e.what()
+              << "\n";
+    return odometry->SkipFrame(i, loaded.frame.timestamp, e.what());
+  }
+}
+
+// summary.json's ms_median and ms_mean: per component over the frames that were not failed;
+// mapping per mapping job (the per-frame column attributes parallel work to frames only
+// approximately).
+void AddTimingSummary(const std::vector<TimingRow>& rows, const std::vector<double>& mapping_jobs,
+                      nlohmann::json* summary) {
+  nlohmann::json median = nlohmann::json::object(), mean = nlohmann::json::object();
+  for (size_t k = 0; k < kNumTimingKeys; ++k) {
+    std::vector<double> column;
+    for (const TimingRow& row : rows) column.push_back(row[k]);
+    if (std::string(kTimingKeys[k]) == "mapping") column = mapping_jobs;
+    median[kTimingKeys[k]] = Median(column);
+    mean[kTimingKeys[k]] = Mean(column);
+  }
+  (*summary)["ms_median"] = median;
+  (*summary)["ms_mean"] = mean;
+}
+
+// The accuracy against the dataset's ground truth into the summary; the report's line.
+std::string AddEvaluation(const Trajectory& ground_truth, const Trajectory& estimate,
+                          nlohmann::json* summary, Sim3Alignment* gt_from_est) {
+  nlohmann::json& s = *summary;
+  try {
+    const EvaluationResult eval = EvaluateTrajectory(ground_truth, estimate);
+    *gt_from_est = eval.gt_from_est;
+    s["rpe_cm_s"] = NumberOrNull(eval.rpe_cm_s);
+    s["rpe_deg_s"] = NumberOrNull(eval.rpe_deg_s);
+    s["ate_m"] = eval.ate_m;
+    s["coverage"] = eval.coverage;
+    s["scale"] = eval.scale;
+    s["scale_drift"] = NumberOrNull(eval.scale_drift);
+    s["window_scales"] = eval.window_scales;
+    std::ostringstream line;
+    line << std::fixed << std::setprecision(3) << "RPE " << eval.rpe_cm_s << " cm/s, "
+         << eval.rpe_deg_s << " deg/s; ATE " << std::setprecision(4) << eval.ate_m
+         << " m; coverage " << std::setprecision(3) << eval.coverage;
+    return line.str();
+  } catch (const std::exception& e) {
+    s["rpe_cm_s"] = nullptr;
+    s["rpe_deg_s"] = nullptr;
+    s["ate_m"] = nullptr;
+    s["coverage"] = 0.0;
+    s["evaluation_error"] = e.what();
+    return std::string("evaluation failed: ") + e.what();
+  }
+}
+
+// OUT/trajectory.svg: the estimate, Sim(3)-aligned when there is ground truth, over it.
+void WriteRunSvg(const std::string& path, const std::string& title, const Trajectory* ground_truth,
+                 const Trajectory& estimate, const Sim3Alignment* gt_from_est) {
+  std::vector<Eigen::Vector3d> gt_positions;
+  if (ground_truth != nullptr) {
+    for (const StampedPose& pose : *ground_truth) {
+      gt_positions.push_back(pose.world_from_cam.translation());
+    }
+  }
+  SvgCurve curve;
+  curve.label = gt_from_est != nullptr ? "estimate (Sim(3)-aligned)" : "estimate";
+  for (const StampedPose& pose : estimate) {
+    const Eigen::Vector3d p = pose.world_from_cam.translation();
+    curve.positions.push_back(gt_from_est != nullptr ? (*gt_from_est) * p : p);
+  }
+  WriteTrajectorySvg(path, title, gt_positions, {curve});
+}
+
+}  // namespace
+
+SequenceRunner::SequenceRunner(const Dataset& dataset, const OdometryConfig& config,
+                               SequenceRunOptions options, RunObserver* observer)
+    : dataset_(dataset), config_(config), options_(std::move(options)), observer_(observer) {}
+
+SequenceRunResult SequenceRunner::Run() {
+  const std::string& out = options_.out_dir;
+  try {
+    std::filesystem::create_directories(out);
+    WriteConfigYaml(config_, out + "/config.yaml");
+  } catch (const std::exception& e) {
+    throw RunOutputError(e.what());
+  }
+  RunFiles files(out, options_.dataset_label);
+  const Trajectory* ground_truth = dataset_.ground_truth();
+  if (ground_truth != nullptr && !ground_truth->empty()) {
+    try {
+      WriteTrajectoryTum(*ground_truth, out + "/groundtruth.txt");
+    } catch (const std::exception& e) {
+      throw RunOutputError(e.what());
+    }
+  }
+
+  const int num_frames =
+      options_.max_frames > 0 ? std::min(options_.max_frames, dataset_.size()) : dataset_.size();
+  const InitialMap initial = PrepareInitialMap(dataset_, config_, num_frames);
+  Odometry odometry(dataset_.camera(), initial.run_config, observer_);
+
+  std::unique_ptr<SolverComparison> comparison;
+  if (config_.odometry.compare_solver != OdometryOptions::CompareSolver::kNone) {
+    comparison = std::make_unique<SolverComparison>(
+        out + "/trajectory_compare.txt",
+        config_.odometry.compare_solver == OdometryOptions::CompareSolver::kCeres ? "ceres"
+                                                                                  : "gauss_newton");
+    if (!comparison->ok()) throw RunOutputError("cannot write into " + out);
+  }
+
+  ProgressBar progress(num_frames, options_.progress && isatty(STDERR_FILENO));
+  std::vector<TimingRow> rows;
+  Trajectory estimate;
+  int failed = 0;
+  const auto run_start = WallClock::now();
+  // Frame i + 1 is loaded (decoded, undistorted) while frame i is processed, and with
+  // odometry.frontend_thread also prepared (pyramid, line detection and description). One task
+  // runs at a time, so the preparer is never used by two threads at once.
+  std::unique_ptr<FramePreparer> preparer;
+  if (initial.run_config.odometry.frontend_thread) {
+    preparer = std::make_unique<FramePreparer>(initial.run_config);
+  }
+  const auto load = [&](int index) {
+    return std::async(std::launch::async, LoadFrame, std::cref(dataset_), index, preparer.get());
+  };
+  std::future<LoadedFrame> next;
+  if (num_frames > 0) next = load(0);
+  for (int i = 0; i < num_frames; ++i) {
+    const auto frame_start = WallClock::now();
+    LoadedFrame loaded = next.get();
+    if (i + 1 < num_frames) next = load(i + 1);
+    const double load_ms = loaded.load_ms;
+    const OdometryFrameResult result =
+        ProcessLoadedFrame(dataset_, initial, config_, i, std::move(loaded), &odometry);
+    if (result.status == FrameStatus::kFailed) ++failed;
+    if (IsTracked(result.status)) {
+      const StampedPose pose{result.timestamp, result.world_from_cam};
+      files.AddPose(pose);
+      estimate.push_back(pose);
+    }
+    if (comparison != nullptr && !comparison->Add(result)) {
+      throw RunOutputError("cannot write " + out +
+                           "/trajectory_compare.txt: " + std::strerror(errno) + "; stopping");
+    }
+    const TimingRow row = MakeTimingRow(result.timing, load_ms, MsSince(frame_start));
+    if (result.status != FrameStatus::kFailed) rows.push_back(row);
+    files.AddTimingRow(result, row);
+    progress.Update(i + 1, odometry.statistics().lost_frames);
+  }
+  odometry.Finish();
+  const double run_seconds = std::chrono::duration<double>(WallClock::now() - run_start).count();
+  const OdometryStatistics stats = odometry.statistics();
+
+  SequenceRunResult result;
+  result.frames = num_frames;
+  result.tracked = stats.tracked;
+  result.failed = failed;
+  nlohmann::json& summary = result.summary;
+  summary["dataset"] = options_.dataset_label;
+  summary["config"] = options_.config_label;
+  summary["frames"] = num_frames;
+  summary["tracked"] = stats.tracked;
+  summary["keyframes"] = stats.keyframes;
+  summary["lost_events"] = stats.lost_events;
+  summary["lost_frames"] = stats.lost_frames;
+  summary["failed_frames"] = failed;
+  summary["reinitializations"] = stats.reinitializations;
+  summary["dropped_mapping_updates"] = stats.dropped_mapping_updates;
+  summary["failed_mapping_jobs"] = stats.failed_mapping_jobs;
+  summary["parallel_mapping"] = config_.odometry.parallel_mapping;
+  summary["frontend_thread"] = config_.odometry.frontend_thread;
+  summary["seconds"] = run_seconds;
+  // Before the run, not in `seconds`: frames and first-keyframe hypotheses per refinement pass;
+  // the two-view bootstrap's second view, triangulated corners, parallax and hypotheses.
+  summary["bootstrap"] = initial.bootstrap;
+  summary["two_view_bootstrap"] = initial.two_view;
+  summary["fps"] = run_seconds > 0.0 ? num_frames / run_seconds : 0.0;
+  // Edge bundle adjustment (backend.edge_ba): windows solved, applied, CPU ms per window, and
+  // the line-depth feedback (backend.edge_ba.line_depth_feedback, docs/edge_ba.md).
+  summary["edge_ba_windows"] = stats.edge_ba_windows;
+  summary["edge_ba_applied"] = stats.edge_ba_applied;
+  summary["edge_ba_ms_median"] = Median(odometry.EdgeBAWindowTimesMs());
+  summary["edge_ba_covariance_ms_median"] = Median(odometry.EdgeBACovarianceTimesMs());
+  summary["edge_ba_covariance_failures"] = stats.edge_ba_covariance_failures;
+  summary["edge_ba_line_depth_jobs"] = stats.edge_ba_line_depth_jobs;
+  summary["edge_ba_line_depths_fused"] = stats.edge_ba_line_depths_fused;
+  summary["edge_ba_line_depth_outliers"] = stats.edge_ba_line_depth_outliers;
+  AddTimingSummary(rows, odometry.MappingJobTimesMs(), &summary);
+
+  std::ostringstream header;
+  header << num_frames << " frames, " << stats.tracked << " tracked, " << stats.keyframes
+         << " keyframes, " << stats.lost_events << " lost events (" << stats.lost_frames
+         << " frames), " << failed << " failed to load; " << std::fixed << std::setprecision(1)
+         << summary["fps"].get<double>() << " frames/s";
+  result.report.push_back(header.str());
+  result.report.push_back("  component        median ms   mean ms");
+  for (const char* key : kTimingKeys) {
+    std::ostringstream line;
+    line << "  " << std::left << std::setw(16) << key << std::right << std::fixed
+         << std::setprecision(2) << std::setw(10) << summary["ms_median"][key].get<double>()
+         << std::setw(10) << summary["ms_mean"][key].get<double>();
+    result.report.push_back(line.str());
+  }
+
+  Sim3Alignment gt_from_est;
+  bool aligned = false;
+  if (ground_truth != nullptr && !ground_truth->empty()) {
+    const std::string line = AddEvaluation(*ground_truth, estimate, &summary, &gt_from_est);
+    aligned = !summary.contains("evaluation_error");
+    result.report.push_back("  " + line);
+  }
+  if (comparison != nullptr) {
+    summary["compare_solver"] = comparison->Summary(ground_truth);
+    result.report.push_back("  " + comparison->Line(summary["compare_solver"]));
+  }
+  if (observer_ != nullptr) {
+    observer_->AddToSummary(&summary);
+    const std::string line = observer_->ReportLine();
+    if (!line.empty()) result.report.push_back("  " + line);
+  }
+  {
+    std::ofstream summary_file(out + "/summary.json");
+    summary_file << summary.dump(2) << "\n";
+    if (!summary_file) throw RunOutputError("cannot write " + out + "/summary.json");
+  }
+  try {
+    WriteRunSvg(out + "/trajectory.svg", options_.dataset_label + " (top view)", ground_truth,
+                estimate, aligned ? &gt_from_est : nullptr);
+  } catch (const std::exception& e) {
+    throw RunOutputError(e.what());
+  }
+  result.report.push_back("  outputs in " + out);
+  return result;
+}
+
+void PrintRunReport(const SequenceRunResult& result, std::ostream& out) {
+  for (size_t i = 0; i < result.report.size(); ++i) {
+    out << (i == 0 ? "pldvo run: " : "") << result.report[i] << "\n";
+  }
+}
+
+}  // namespace pldvo

@@ -1,0 +1,275 @@
+#include "backend/odometry/two_view_bootstrap.h"
+
+#include <ceres/autodiff_cost_function.h>
+#include <ceres/loss_function.h>
+#include <ceres/manifold.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "backend/mapping/depth_map_io.h"
+#include "backend/mapping/depth_mapper.h"
+#include "core/evaluation.h"
+#include "core/wall_clock.h"
+
+namespace pldvo {
+namespace {
+
+// Corner detection and tracking (OpenCV's defaults where it has them).
+constexpr int kMaxCorners = 1000;
+constexpr double kCornerQuality = 0.01;
+constexpr double kCornerMinDistancePx = 7.0;
+constexpr int kLkWindowPx = 21;
+constexpr int kLkLevels = 3;
+// A track survives a frame when tracking back lands within this of where it started.
+constexpr double kForwardBackwardPx = 1.0;
+// Five-point RANSAC (OpenCV's defaults).
+constexpr double kRansacConfidence = 0.999;
+constexpr double kRansacThresholdPx = 1.0;
+// Bundle adjustment: Huber scale of the reprojection error and iteration cap.
+constexpr double kHuberPx = 1.0;
+constexpr int kMaxBundleIterations = 50;
+
+cv::Mat ToGray8(const cv::Mat& image) {
+  cv::Mat gray;
+  image.convertTo(gray, CV_8U);
+  return gray;
+}
+
+// One corner of frame 0 followed through the frames: its position in every frame so far.
+struct Track {
+  std::vector<cv::Point2f> positions;
+};
+
+// Tracks every live track into `next` (forward-backward checked) and drops the lost ones.
+void TrackInto(const cv::Mat& previous, const cv::Mat& next, std::vector<Track>* tracks) {
+  std::vector<cv::Point2f> from, to, back;
+  for (const Track& track : *tracks) from.push_back(track.positions.back());
+  if (from.empty()) return;
+  std::vector<uchar> ok, ok_back;
+  std::vector<float> error;
+  const cv::Size window(kLkWindowPx, kLkWindowPx);
+  cv::calcOpticalFlowPyrLK(previous, next, from, to, ok, error, window, kLkLevels);
+  cv::calcOpticalFlowPyrLK(next, previous, to, back, ok_back, error, window, kLkLevels);
+  std::vector<Track> kept;
+  for (size_t i = 0; i < tracks->size(); ++i) {
+    const cv::Point2f d = back[i] - from[i];
+    const bool inside = to[i].x >= 0.f && to[i].y >= 0.f && to[i].x <= next.cols - 1.f &&
+                        to[i].y <= next.rows - 1.f;
+    if (!ok[i] || !ok_back[i] || !inside || std::hypot(d.x, d.y) > kForwardBackwardPx) continue;
+    kept.push_back(std::move((*tracks)[i]));
+    kept.back().positions.push_back(to[i]);
+  }
+  *tracks = std::move(kept);
+}
+
+// The relative pose frame_k <- frame_0 and the triangulated corners (frame 0 coordinates) of the
+// essential-matrix inliers in front of both cameras.
+struct TwoViewGeometry {
+  Eigen::Matrix3d rotation;
+  Eigen::Vector3d translation;          // unit length
+  std::vector<int> track_ids;           // the inliers' indices into the tracks
+  std::vector<Eigen::Vector3d> points;  // their triangulated positions
+  double median_parallax_deg = 0.0;
+};
+
+TwoViewGeometry EstimateTwoViewGeometry(const std::vector<Track>& tracks, const cv::Matx33d& K) {
+  TwoViewGeometry geometry;
+  std::vector<cv::Point2f> p0, pk;
+  for (const Track& track : tracks) {
+    p0.push_back(track.positions.front());
+    pk.push_back(track.positions.back());
+  }
+  cv::Mat mask;
+  const cv::Mat E =
+      cv::findEssentialMat(p0, pk, K, cv::RANSAC, kRansacConfidence, kRansacThresholdPx, mask);
+  if (E.rows != 3 || E.cols != 3) return geometry;  // degenerate or several solutions
+  cv::Mat R, t, points4;
+  // Points farther than this (in baselines) count as behind: pure rotation gives none in front.
+  constexpr double kMaxDistanceBaselines = 1000.0;
+  cv::recoverPose(E, p0, pk, K, R, t, kMaxDistanceBaselines, mask, points4);
+  points4.convertTo(points4, CV_64F);
+  cv::cv2eigen(R, geometry.rotation);
+  cv::cv2eigen(t, geometry.translation);
+  std::vector<double> parallax_deg;
+  const Eigen::Vector3d centre_k = -geometry.rotation.transpose() * geometry.translation;
+  for (int i = 0; i < mask.rows; ++i) {
+    if (!mask.at<uchar>(i)) continue;
+    const double w = points4.at<double>(3, i);
+    const Eigen::Vector3d X(points4.at<double>(0, i) / w, points4.at<double>(1, i) / w,
+                            points4.at<double>(2, i) / w);
+    const double cos_angle = X.normalized().dot((X - centre_k).normalized());
+    geometry.track_ids.push_back(i);
+    geometry.points.push_back(X);
+    parallax_deg.push_back(std::acos(std::clamp(cos_angle, -1.0, 1.0)) * 180.0 / M_PI);
+  }
+  if (!parallax_deg.empty()) geometry.median_parallax_deg = Median(parallax_deg);
+  return geometry;
+}
+
+// Reprojection error of a point X (frame 0 coordinates) in a frame with pose
+// cam_from_ref = (q, t): pi(q X + t) - x, pixels.
+struct ReprojectionError {
+  ReprojectionError(const cv::Point2f& observed, const cv::Matx33d& K) : x(observed), K(K) {}
+  template <class T>
+  bool operator()(const T* q, const T* t, const T* X, T* residual) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> rotation(q);
+    const Eigen::Matrix<T, 3, 1> p = rotation * Eigen::Map<const Eigen::Matrix<T, 3, 1>>(X) +
+                                     Eigen::Map<const Eigen::Matrix<T, 3, 1>>(t);
+    residual[0] = K(0, 0) * p.x() / p.z() + K(0, 2) - T(x.x);
+    residual[1] = K(1, 1) * p.y() / p.z() + K(1, 2) - T(x.y);
+    return true;
+  }
+  cv::Point2f x;
+  cv::Matx33d K;
+};
+
+// Bundle adjustment of the poses of frames 1..k (frame 0 fixed at the identity) and of the
+// triangulated corners over all their observations in frames 0..k. Gauge: frame 0 fixed and
+// frame k's translation on a sphere (SphereManifold keeps its norm). Poses start interpolated
+// between frame 0 and the two-view pose of frame k (slerp / linear in the frame index).
+void BundleAdjust(const std::vector<Track>& tracks, const std::vector<int>& track_ids,
+                  const cv::Matx33d& K, std::vector<Eigen::Quaterniond>* rotations,
+                  std::vector<Eigen::Vector3d>* translations,
+                  std::vector<Eigen::Vector3d>* points) {
+  const int k = static_cast<int>(rotations->size()) - 1;
+  ceres::HuberLoss loss(kHuberPx);  // one for every residual block
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  for (int j = 0; j <= k; ++j) {
+    problem.AddParameterBlock((*rotations)[j].coeffs().data(), 4,
+                              new ceres::EigenQuaternionManifold());
+    problem.AddParameterBlock((*translations)[j].data(), 3);
+  }
+  problem.SetParameterBlockConstant((*rotations)[0].coeffs().data());
+  problem.SetParameterBlockConstant((*translations)[0].data());
+  problem.SetManifold((*translations)[k].data(), new ceres::SphereManifold<3>());
+  for (size_t i = 0; i < track_ids.size(); ++i) {
+    for (int j = 0; j <= k; ++j) {
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ReprojectionError, 2, 4, 3, 3>(
+                                   new ReprojectionError(tracks[track_ids[i]].positions[j], K)),
+                               &loss, (*rotations)[j].coeffs().data(), (*translations)[j].data(),
+                               (*points)[i].data());
+    }
+  }
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::SPARSE_SCHUR;
+  options.max_num_iterations = kMaxBundleIterations;
+  options.logging_type = ceres::SILENT;
+  options.num_threads = 1;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+}
+
+}  // namespace
+
+TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryConfig& config,
+                                       int num_frames) {
+  const auto start = WallClock::now();
+  const OdometryOptions& options = config.odometry;
+  const int last = std::min(num_frames, options.two_view_max_frames + 1);
+  if (last < 2) throw std::runtime_error("two-view bootstrap: fewer than two frames");
+  const PinholeCamera& camera = dataset.camera();
+  const cv::Matx33d K(camera.fx, 0.0, camera.cx, 0.0, camera.fy, camera.cy, 0.0, 0.0, 1.0);
+
+  std::vector<cv::Mat> images{dataset.Load(0).image};
+  cv::Mat previous = ToGray8(images[0]);
+  std::vector<cv::Point2f> corners;
+  cv::goodFeaturesToTrack(previous, corners, kMaxCorners, kCornerQuality, kCornerMinDistancePx);
+  if (static_cast<int>(corners.size()) < options.two_view_min_inliers) {
+    throw std::runtime_error("two-view bootstrap: frame 0 has " + std::to_string(corners.size()) +
+                             " corners, fewer than two_view_min_inliers");
+  }
+  std::vector<Track> tracks;
+  for (const cv::Point2f& corner : corners) tracks.push_back({{corner}});
+
+  TwoViewBootstrap result;
+  TwoViewGeometry geometry;
+  // The frame with enough corners and the largest median parallax so far (error message).
+  std::string best = "none";
+  double best_parallax_deg = -1.0;
+  for (int k = 1; k < last && result.second_view < 0; ++k) {
+    images.push_back(dataset.Load(k).image);
+    const cv::Mat next = ToGray8(images.back());
+    TrackInto(previous, next, &tracks);
+    previous = next;
+    if (static_cast<int>(tracks.size()) < options.two_view_min_inliers) {
+      throw std::runtime_error("two-view bootstrap: " + std::to_string(tracks.size()) +
+                               " corners left at frame " + std::to_string(k) +
+                               ", fewer than two_view_min_inliers");
+    }
+    geometry = EstimateTwoViewGeometry(tracks, K);
+    const bool enough = static_cast<int>(geometry.points.size()) >= options.two_view_min_inliers;
+    if (enough && geometry.median_parallax_deg > best_parallax_deg) {
+      best_parallax_deg = geometry.median_parallax_deg;
+      best = "frame " + std::to_string(k) + ": " + std::to_string(geometry.points.size()) +
+             " corners, " + std::to_string(best_parallax_deg) + " deg";
+    }
+    if (enough && geometry.median_parallax_deg >= options.two_view_min_parallax_deg) {
+      result.second_view = k;
+    }
+  }
+  if (result.second_view < 0) {
+    throw std::runtime_error("two-view bootstrap: no frame up to " + std::to_string(last - 1) +
+                             " has " + std::to_string(options.two_view_min_inliers) +
+                             " corners triangulated with a median parallax of " +
+                             std::to_string(options.two_view_min_parallax_deg) +
+                             " deg (largest with enough corners: " + best + ")");
+  }
+  result.tracks = static_cast<int>(tracks.size());
+  result.inliers = static_cast<int>(geometry.points.size());
+  result.parallax_deg = geometry.median_parallax_deg;
+
+  // Poses of frames 0..k (cam_from_ref) and corners, refined together over every frame.
+  const int k = result.second_view;
+  const Eigen::Quaterniond rotation_k(geometry.rotation);
+  std::vector<Eigen::Quaterniond> rotations;
+  std::vector<Eigen::Vector3d> translations;
+  for (int j = 0; j <= k; ++j) {
+    const double f = static_cast<double>(j) / k;
+    rotations.push_back(Eigen::Quaterniond::Identity().slerp(f, rotation_k));
+    translations.push_back(f * geometry.translation);
+  }
+  std::vector<Eigen::Vector3d> points = geometry.points;
+  BundleAdjust(tracks, geometry.track_ids, K, &rotations, &translations, &points);
+
+  // Scale: median inverse depth of the corners in front of frame 0 is 1.
+  std::vector<double> idepths;
+  for (const Eigen::Vector3d& X : points) {
+    if (X.z() > 0.0) idepths.push_back(1.0 / X.z());
+  }
+  if (idepths.empty()) {
+    throw std::runtime_error("two-view bootstrap: no corner in front after the adjustment");
+  }
+  const double scale = Median(idepths);
+
+  // Frame 0's map from the random initialisation, fused with frames 1..k in order (small
+  // baselines first, as in the run).
+  DepthMapper mapper(camera, config.mapping);
+  mapper.InitializeKeyframe(images[0], EdgeTrace());
+  for (int j = 1; j <= k; ++j) {
+    mapper.UpdateWithFrame(images[j], SE3(rotations[j], translations[j] * scale), {});
+  }
+
+  double median_idepth = 0.0;  // of the map: `depth` is in units of 1 / median_idepth
+  result.depth = NormalizedObservedDepth(mapper.depth_map(), &result.points, &median_idepth);
+  if (result.depth.empty()) {
+    throw std::runtime_error("two-view bootstrap: frame 0's map has no observed hypothesis");
+  }
+  result.second_from_first = SE3(rotations[k], translations[k] * scale * median_idepth);
+  result.ms = MsSince(start);
+  return result;
+}
+
+}  // namespace pldvo

@@ -1,0 +1,56 @@
+// Two-view bootstrap of the first keyframe's map (odometry.two_view_bootstrap; docs/odometry.md,
+// "Two-view bootstrap").
+//
+// The semi-dense VO starts from a random inverse-depth map (Engel 2013 Sec. 2.1) and tracks the
+// first frames against it. Under rotation-dominant motion that yields a self-consistent but wrong
+// pair of poses and map (docs/odometry.md, "Keyframe maps in monocular runs"). Here the first
+// frames' motion comes from image geometry instead, as in feature-based monocular SLAM
+// (ORB-SLAM, SVO):
+//   1. corners of frame 0 (Shi-Tomasi) are tracked frame to frame by pyramidal Lucas-Kanade
+//      with a forward-backward check;
+//   2. at every frame k, the essential matrix between frame 0 and k (five-point RANSAC) and its
+//      decomposition give (R, t) and triangulated corners; k is the second view when at least
+//      min_inliers corners are triangulated in front of both cameras with a median parallax
+//      angle of at least min_parallax_deg;
+//   3. the poses of frames 1..k and the corners are refined together over all their observations
+//      (bundle adjustment with Ceres, Huber loss; frame 0 fixed, |t_k| fixed), starting from
+//      poses interpolated between frame 0 and the two-view pose;
+//   4. frame 0's semi-dense map is estimated from the random initialisation by the mapping's own
+//      stereo and EKF with the poses of frames 1..k (photometric stereo, no lines: both
+//      configurations start alike), with the scale set by a median corner inverse depth of 1.
+// The run then starts from that map (its observed hypotheses) with inverse-depth variance
+// odometry.bootstrap_idepth_var, and tracks frames 1..k again.
+#ifndef PLDVO_BACKEND_ODOMETRY_TWO_VIEW_BOOTSTRAP_H_
+#define PLDVO_BACKEND_ODOMETRY_TWO_VIEW_BOOTSTRAP_H_
+
+#include <opencv2/core.hpp>
+
+#include "backend/odometry/odometry_config.h"
+#include "core/dataset.h"
+#include "core/se3.h"
+
+namespace pldvo {
+
+struct TwoViewBootstrap {
+  // Frame 0's z-depth (CV_32F; 0 where the map has no observed hypothesis), median inverse depth
+  // 1: the start of the run proper.
+  cv::Mat depth;
+  int second_view = -1;       // frame index k of the second view
+  SE3 second_from_first;      // its pose (cam_from_ref), in the scale of `depth`
+  int tracks = 0;             // corners tracked from frame 0 to k
+  int inliers = 0;            // of which: essential-matrix inliers triangulated in front
+  double parallax_deg = 0.0;  // their median parallax angle
+  int points = 0;             // observed hypotheses of frame 0's map
+  double ms = 0.0;            // wall time
+};
+
+// Runs the two-view bootstrap over the first min(num_frames, two_view_max_frames) frames of
+// `dataset` with config.mapping. Throws std::runtime_error, saying why, when frame 0 cannot be
+// loaded or has too few corners, when the tracks are lost, when no frame reaches the parallax,
+// or when the map ends without observed hypotheses.
+TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryConfig& config,
+                                       int num_frames);
+
+}  // namespace pldvo
+
+#endif  // PLDVO_BACKEND_ODOMETRY_TWO_VIEW_BOOTSTRAP_H_

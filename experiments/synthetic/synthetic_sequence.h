@@ -1,0 +1,262 @@
+// Synthetic indoor sequences with exact ground truth: a room of planes and boxes (walls, floor,
+// ceiling, cabinets, a table, a door, picture frames, shelves) drawn from a seed, rendered by
+// per-pixel analytic ray casting with Lambertian shading (ambient + one point light),
+// adaptive supersampling at surface boundaries, Gaussian sensor noise, optional motion blur and
+// vignetting. The camera follows a smooth handheld-like trajectory at 30 fps that stays inside
+// the free space of the room and always looks at scene content.
+//
+// Conventions: world frame z up, floor at z = 0, the room spans [0, room_size.x] x
+// [0, room_size.y] x [0, room_size.z]; camera x right, y down, z forward; poses are
+// world_from_cam; depth is the z-depth in metres of the surface seen at the pixel centre.
+// See docs/synthetic.md.
+#ifndef PLDVO_EXPERIMENTS_SYNTHETIC_SYNTHETIC_SEQUENCE_H_
+#define PLDVO_EXPERIMENTS_SYNTHETIC_SYNTHETIC_SEQUENCE_H_
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "core/options.h"
+#include "core/pinhole_camera.h"
+#include "core/se3.h"
+#include "core/trajectory_io.h"
+
+namespace pldvo::synthetic {
+
+// Every parameter of a sequence. Fields documented "< 0: preset" take their value from the
+// preset unless set; ResolvePreset() fills them in (MakeSequence calls it).
+struct SynthOptions {
+  std::string preset = "lowtex";  // textured | lowtex | lighting | fast
+  int frames = 300;
+  int seed = 1;  // scene layout, trajectory and noise; any value >= 0
+  int width = 640;
+  int height = 480;
+  double fx = 525.0;
+  double fy = 525.0;
+  double cx = -1.0;  // < 0: (width - 1) / 2
+  double cy = -1.0;  // < 0: (height - 1) / 2
+  double fps = 30.0;
+  double noise_sigma = 1.0;              // gray levels, Gaussian, i.i.d. per pixel
+  int supersampling = 4;                 // n x n samples at pixels on a surface boundary; 1 = off
+  double texture_filter_sigma_px = 0.0;  // Gaussian pixel response on textures; 0 = point samples
+  bool motion_blur = false;
+  int motion_blur_samples = 5;  // sub-frame poses averaged when motion_blur
+  double exposure = 0.5;        // exposure time as a fraction of the frame interval
+  bool vignetting = false;
+  double vignetting_strength = 0.3;  // relative darkening at the image corners
+  double speed = -1.0;               // mean camera speed in m/s; < 0: preset (0.25, fast 0.75)
+  double angular_speed = -1.0;       // mean rotation rate in deg/s; < 0: preset (15, fast 45)
+  double texture_contrast = -1.0;    // albedo pattern amplitude; < 0: preset (textured 0.3, else 0)
+  double albedo_variation = 0.03;    // smooth 1 m-scale albedo variation on every surface
+  double gain_amplitude = -1.0;      // relative global gain swing; < 0: preset (lighting 0.25)
+  double bias_amplitude = -1.0;      // global bias swing in gray levels; < 0: preset (lighting 15)
+  double light_motion = -1.0;        // radius in m of the moving light's circle; < 0: preset
+  double lighting_period = 8.0;      // seconds per cycle of gain, bias and light motion
+  double ambient = 0.35;             // ambient term of the shading (albedo 1 -> 255 * ambient)
+  double light_intensity = 0.75;     // point-light term at normal incidence, 2.5 m away
+  double min_depth = 0.5;            // metres: every pixel of every frame sees at least this far
+  double clearance = 0.35;           // metres from the camera centre to any surface
+  int threads = 0;                   // render threads; 0 = hardware concurrency
+
+  template <class Visitor>
+  void VisitFields(Visitor& v) {
+    v.Field("preset", &preset, "Scene appearance and motion: textured | lowtex | lighting | fast.");
+    v.Field("frames", &frames, "Number of frames (30 fps).");
+    v.Field("seed", &seed, "Seed of the scene layout, trajectory and noise (>= 0).");
+    v.Field("width", &width, "Image width in pixels.");
+    v.Field("height", &height, "Image height in pixels.");
+    v.Field("fx", &fx, "Focal length in x (pixels).");
+    v.Field("fy", &fy, "Focal length in y (pixels).");
+    v.Field("cx", &cx, "Principal point x (pixels); < 0 centres it at (width - 1) / 2.");
+    v.Field("cy", &cy, "Principal point y (pixels); < 0 centres it at (height - 1) / 2.");
+    v.Field("fps", &fps, "Frame rate of the timestamps and of the motion.");
+    v.Field("noise_sigma", &noise_sigma, "Gaussian sensor noise, gray levels (0 = off).");
+    v.Field("supersampling", &supersampling,
+            "n x n samples per pixel on surface boundaries (anti-aliasing); 1 = off.");
+    v.Field("texture_filter_sigma_px", &texture_filter_sigma_px,
+            "Std. dev. in pixels of the Gaussian pixel response that band-limits the textures "
+            "(0 = point samples, which alias fine patterns at grazing angles).");
+    v.Field("motion_blur", &motion_blur, "Average sub-frame renderings over the exposure.");
+    v.Field("motion_blur_samples", &motion_blur_samples, "Sub-frames per motion-blurred frame.");
+    v.Field("exposure", &exposure, "Exposure as a fraction of the frame interval (motion blur).");
+    v.Field("vignetting", &vignetting, "Darken the image towards the corners.");
+    v.Field("vignetting_strength", &vignetting_strength,
+            "Relative darkening at the corners: I *= 1 - s (r / r_corner)^2.");
+    v.Field("speed", &speed, "Mean camera speed in m/s; < 0: preset (0.25, fast 0.75).");
+    v.Field("angular_speed", &angular_speed,
+            "Mean camera rotation rate in deg/s; < 0: preset (15, fast 45).");
+    v.Field("texture_contrast", &texture_contrast,
+            "Amplitude of the procedural albedo pattern; < 0: preset (textured 0.3, else 0).");
+    v.Field("albedo_variation", &albedo_variation,
+            "Amplitude of a smooth (1 m cells) albedo variation on every surface.");
+    v.Field("gain_amplitude", &gain_amplitude,
+            "Relative swing of the global gain; < 0: preset (lighting 0.25, else 0).");
+    v.Field("bias_amplitude", &bias_amplitude,
+            "Swing of the global bias in gray levels; < 0: preset (lighting 15, else 0).");
+    v.Field("light_motion", &light_motion,
+            "Radius in m of the point light's circular motion; < 0: preset (lighting 1, else 0).");
+    v.Field("lighting_period", &lighting_period,
+            "Seconds per cycle of the gain, bias and light motion.");
+    v.Field("ambient", &ambient, "Ambient shading term.");
+    v.Field("light_intensity", &light_intensity,
+            "Point-light shading term at normal incidence and 2.5 m distance.");
+    v.Field("min_depth", &min_depth, "Minimum depth (m) of every pixel of every frame.");
+    v.Field("clearance", &clearance, "Minimum distance (m) from the camera to any surface.");
+    v.Field("threads", &threads, "Render threads; 0 = hardware concurrency.");
+  }
+  // "" when valid, otherwise what is wrong (names the field).
+  std::string Check() const;
+};
+
+// The options with every "< 0: preset" field filled from the preset, and cx, cy centred.
+// Throws std::invalid_argument on an unknown preset or invalid options.
+SynthOptions ResolvePreset(const SynthOptions& options);
+
+struct Segment3d {
+  Eigen::Vector3d start_in_world;
+  Eigen::Vector3d end_in_world;
+};
+
+struct RenderedFrame {
+  cv::Mat image;  // CV_8U gray
+  cv::Mat depth;  // CV_32F z-depth in metres, 0 where nothing is hit
+};
+
+// One solid or the room's interior. A box is oriented: box_from_world maps the world into the
+// box frame, where it spans [-half_size, half_size].
+struct Primitive {
+  enum class Kind { kRoom, kBox };
+  enum class Pattern { kPlain, kNoise, kWood, kTiles };
+  Kind kind = Kind::kBox;
+  Eigen::Matrix3d box_from_world_rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d center_in_world = Eigen::Vector3d::Zero();
+  Eigen::Vector3d half_size = Eigen::Vector3d::Ones();
+  double albedo[6] = {0.5, 0.5, 0.5, 0.5, 0.5, 0.5};  // faces -x, +x, -y, +y, -z, +z
+  Pattern pattern[6] = {Pattern::kNoise, Pattern::kNoise, Pattern::kNoise,
+                        Pattern::kNoise, Pattern::kNoise, Pattern::kNoise};
+  double texture_scale = 0.1;  // metres per texture cell
+  uint32_t texture_seed = 0;
+  std::string name;  // "wall", "cabinet", "table_top", ... (for docs and debugging)
+};
+
+// What a pixel integrates at a ray's hit: the hit point's derivatives with respect to the image
+// x and y (world frame, metres per pixel) and the standard deviation of the pixel's Gaussian
+// response in pixels (0: the pixel samples the surface at one point).
+struct PixelFootprint {
+  Eigen::Vector3d point_per_x = Eigen::Vector3d::Zero();
+  Eigen::Vector3d point_per_y = Eigen::Vector3d::Zero();
+  double sigma_px = 0.0;
+
+  // Ray differentials (Igehy 1999) on the hit's plane n . (p - p_hit) = 0, for the ray
+  // origin + t direction whose direction changes by ray_per_x, ray_per_y per pixel: a direction
+  // d + e meets the plane at p_hit + t (e - d (n . e) / (n . d)) to first order. A ray along the
+  // plane gets a footprint so wide that the pattern takes its mean.
+  static PixelFootprint OnPlane(const Eigen::Vector3d& normal, const Eigen::Vector3d& direction,
+                                double t, const Eigen::Vector3d& ray_per_x,
+                                const Eigen::Vector3d& ray_per_y, double sigma_px);
+};
+
+class Scene {
+ public:
+  Scene() = default;
+  // A random room layout drawn from the seed.
+  static Scene Generate(uint64_t seed);
+
+  const std::vector<Primitive>& primitives() const { return primitives_; }
+  // The scene's 3D edge segments: the room's 12 edges and the edges of every box (box-on-wall
+  // and box-on-floor contacts included, as they are visible boundaries). Edges shorter than
+  // 5 cm are left out.
+  const std::vector<Segment3d>& edges() const { return edges_; }
+  // The room's interior extent from the origin (x, y, z), metres.
+  const Eigen::Vector3d& room_size() const { return room_size_; }
+  // Default light position (the lighting preset moves it around this point).
+  const Eigen::Vector3d& light_in_world() const { return light_in_world_; }
+
+  // Nearest surface along a ray (direction need not be normalised): the ray parameter t > 0
+  // (point = origin + t * direction), the primitive index, face (0..5) and outward normal.
+  // Returns false when nothing is hit.
+  struct Hit {
+    double t = 0.0;
+    int primitive = -1;
+    int face = -1;
+    Eigen::Vector3d normal_in_world = Eigen::Vector3d::Zero();
+  };
+  bool Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, Hit* hit) const;
+  // The same over the primitives listed in `indices` (the renderer's per-tile candidates).
+  bool IntersectSubset(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                       const int* indices, int count, Hit* hit) const;
+  // Albedo at a hit point: the face's albedo times its procedural pattern
+  // (1 + texture_contrast (2 w - 1), w in [0, 1]) and a smooth variation
+  // (1 + albedo_variation (2 n - 1), n value noise of 1 m cells). With a footprint of
+  // sigma_px > 0 the pattern is band-limited by the pixel's response (docs/synthetic.md,
+  // "Texture filtering"): sinusoidal bands exactly, value noise and grout approximately.
+  double Albedo(const Hit& hit, const Eigen::Vector3d& point_in_world, double texture_contrast,
+                double albedo_variation, const PixelFootprint& footprint) const;
+  // Distance from a point to the nearest surface (room walls and boxes).
+  double DistanceToSurfaces(const Eigen::Vector3d& point_in_world) const;
+
+  // For building scenes by hand (tests): adds a primitive and its edges.
+  void AddPrimitive(const Primitive& primitive);
+  void SetRoom(const Eigen::Vector3d& room_size);
+  void SetLight(const Eigen::Vector3d& light_in_world) { light_in_world_ = light_in_world; }
+
+ private:
+  std::vector<Primitive> primitives_;
+  std::vector<Segment3d> edges_;
+  Eigen::Vector3d room_size_ = Eigen::Vector3d(5.0, 5.0, 2.7);
+  Eigen::Vector3d light_in_world_ = Eigen::Vector3d(2.5, 2.5, 2.4);
+};
+
+// The continuous camera motion: position and viewing angles are sums of sinusoids of time
+// (smooth, bounded, handheld-like). Positions: p_a(t) = center_a + sum_k amp sin(freq t + phase)
+// for a = x, y, z; angles (yaw about world z, pitch, roll) alike, around angle_offset.
+struct CameraPath {
+  static constexpr int kTerms = 3;
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angle_offset = Eigen::Vector3d::Zero();  // yaw, pitch, roll in radians
+  double amp[3][kTerms] = {}, freq[3][kTerms] = {}, phase[3][kTerms] = {};
+  double angle_amp[3][kTerms] = {}, angle_freq[3][kTerms] = {}, angle_phase[3][kTerms] = {};
+  Eigen::Vector3d PositionInWorld(double time) const;
+  // yaw, pitch, roll.
+  Eigen::Vector3d Angles(double time) const;
+  // Camera looking along (cos p cos y, cos p sin y, sin p) with x horizontal (before the roll),
+  // then rolled about its z axis.
+  SE3 WorldFromCam(double time) const;
+};
+
+struct SyntheticSequence {
+  SynthOptions options;  // resolved (ResolvePreset)
+  PinholeCamera camera;
+  Scene scene;
+  Trajectory ground_truth;  // world_from_cam per frame; timestamps index / fps
+  CameraPath path;          // ground_truth[i].world_from_cam == path.WorldFromCam(i / fps)
+};
+
+// Global photometric state at a time: I = gain * radiance + bias, and the light position.
+struct Lighting {
+  double gain = 1.0;
+  double bias = 0.0;
+  Eigen::Vector3d light_in_world = Eigen::Vector3d::Zero();
+};
+Lighting LightingAt(const SyntheticSequence& sequence, double time);
+
+// Draws the scene and trajectory; throws std::invalid_argument on invalid options and
+// std::runtime_error when no trajectory meeting clearance and min_depth is found.
+SyntheticSequence MakeSequence(const SynthOptions& options);
+// Frame `index` with every effect the options enable. Deterministic: the noise is seeded by
+// (seed, index, pixel), independent of the thread count.
+RenderedFrame RenderFrame(const SyntheticSequence& sequence, int index);
+// A noise-free, blur-free, vignetting-free view from any pose with the lighting of time 0
+// (for tests).
+RenderedFrame RenderView(const SyntheticSequence& sequence, const SE3& world_from_cam);
+// TUM layout: rgb/ (8-bit gray PNG), depth/ (16-bit PNG, metres x 5000), rgb.txt, depth.txt,
+// groundtruth.txt (world_from_cam), camera.yaml (pinhole), lines.txt (x1 y1 z1 x2 y2 z2 in
+// world per line), synth_config.yaml (the resolved options). Creates `dir`. Returns the
+// rendering rate in frames per second (rendering only, without PNG encoding).
+double WriteSequence(const SyntheticSequence& sequence, const std::string& dir);
+
+}  // namespace pldvo::synthetic
+
+#endif  // PLDVO_EXPERIMENTS_SYNTHETIC_SYNTHETIC_SEQUENCE_H_

@@ -1,0 +1,93 @@
+// Tests of SequenceRunner (backend/odometry/sequence_runner.h), in-process: the run loop writes
+// every output, the ground truth it writes gives evo the same comparison as the run's own
+// evaluation, and an output that cannot be written stops the run with RunOutputError.
+#include "backend/odometry/sequence_runner.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "core/evaluation.h"
+#include "core/trajectory_io.h"
+#include "tests/experiments/test_folder.h"
+#include "tests/render_cache.h"
+#include "tests/small_lowtex_options.h"
+
+namespace pldvo {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr int kFrames = 36;  // 1.2 s: RPE needs pairs 1 s apart
+
+fs::path SequenceDir() {
+  static const fs::path dir = [] {
+    synthetic::SynthOptions options = test::SmallLowtexOptions(kFrames);
+#ifdef PLDVO_SANITIZE
+    options.supersampling = 1;  // rendering dominates this test under the sanitizers
+#endif
+    return test::SequenceFolderForTest(options, test::TestRoot() / "lowtex");
+  }();
+  return dir;
+}
+
+OdometryConfig DeterministicConfig() {
+  OdometryConfig config;
+  config.odometry.parallel_mapping = false;
+  return config;
+}
+
+TEST(SequenceRunnerTest, WritesEveryOutputAndAGroundTruthEvoCanCompare) {
+  const std::unique_ptr<Dataset> dataset = OpenDataset(SequenceDir().string());
+  SequenceRunOptions options;
+  options.out_dir = (test::TestRoot() / "runner_all").string();
+  options.dataset_label = SequenceDir().string();
+  options.max_frames = 30;
+  SequenceRunner runner(*dataset, DeterministicConfig(), options);
+  const SequenceRunResult result = runner.Run();
+
+  EXPECT_EQ(result.frames, 30);
+  EXPECT_EQ(result.tracked, 30);
+  EXPECT_EQ(result.failed, 0);
+  EXPECT_EQ(result.summary["frames"], 30);
+  for (const char* file : {"config.yaml", "trajectory.txt", "groundtruth.txt", "timing.csv",
+                           "summary.json", "trajectory.svg"}) {
+    EXPECT_TRUE(fs::exists(fs::path(options.out_dir) / file)) << file;
+  }
+  const Trajectory estimate = ReadTrajectoryTum(options.out_dir + "/trajectory.txt");
+  ASSERT_EQ(estimate.size(), 30u);
+  // groundtruth.txt is the dataset's ground truth, in the trajectory's frame and format: the
+  // comparison of the two files (what evo does) is the run's own evaluation.
+  const Trajectory ground_truth = ReadTrajectoryTum(options.out_dir + "/groundtruth.txt");
+  ASSERT_EQ(ground_truth.size(), dataset->ground_truth()->size());
+  const EvaluationResult from_files = EvaluateTrajectory(ground_truth, estimate);
+  ASSERT_TRUE(result.summary["rpe_cm_s"].is_number());
+  // The TUM files hold the shortest decimals that read back exactly (trajectory_io.h): only the
+  // summary's JSON round trip separates the two.
+  EXPECT_NEAR(from_files.rpe_cm_s, result.summary["rpe_cm_s"].get<double>(), 1e-9);
+  EXPECT_NEAR(from_files.ate_m, result.summary["ate_m"].get<double>(), 1e-12);
+  // The plot has the ground truth and the aligned estimate.
+  std::stringstream svg;
+  svg << std::ifstream(options.out_dir + "/trajectory.svg").rdbuf();
+  EXPECT_NE(svg.str().find("<svg"), std::string::npos);
+  EXPECT_NE(svg.str().find("Sim(3)-aligned"), std::string::npos);
+  // The report: counts, the component table, the evaluation, the output folder.
+  ASSERT_GE(result.report.size(), 3u);
+  EXPECT_NE(result.report[0].find("30 frames, 30 tracked"), std::string::npos) << result.report[0];
+}
+
+TEST(SequenceRunnerTest, AnOutputFolderThatCannotBeMadeIsAnOutputError) {
+  const std::unique_ptr<Dataset> dataset = OpenDataset(SequenceDir().string());
+  const fs::path blocker = test::TestRoot() / "a_file";
+  std::ofstream(blocker) << "not a folder\n";
+  SequenceRunOptions options;
+  options.out_dir = (blocker / "out").string();
+  options.max_frames = 2;
+  SequenceRunner runner(*dataset, DeterministicConfig(), options);
+  EXPECT_THROW(runner.Run(), RunOutputError);
+}
+
+}  // namespace
+}  // namespace pldvo
