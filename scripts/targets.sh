@@ -10,15 +10,32 @@
 #      quiet day of this 2-core VM; slow days reach 2.5x);
 #   3. Ceres and Gauss-Newton on the same tracking problems (odometry.compare_solver=ceres):
 #      RPE of the two trajectories within 1%, on the six sequences and on KITTI;
-#   4. KITTI 00 (first 200 frames; ${PLDVO_KITTI:-../shared/data/kitti00_first200}, skipped when
-#      absent): sdvo and points_lines run to the end, RPE and ATE.
-# Usage: scripts/targets.sh [OUT]   (default /tmp/pldvo_targets). Sequences and grid runs already
+#   4. KITTI 00 (first 200 frames; the folder ${PLDVO_KITTI:-../shared/data/kitti00_first200},
+#      TUM or KITTI layout, docs/datasets.md "KITTI 00 excerpt"; skipped when absent): sdvo and
+#      points_lines run to the end, RPE and ATE;
+#   5. real data (PLDVO_REAL: comma-separated dataset folders, e.g. TUM fr1/rpy; skipped when
+#      unset): sdvo and points_lines with the mapping thread, RPE, lost events, time per component.
+# Usage: scripts/targets.sh [OUT] [--write-results FILE]   (default OUT /tmp/pldvo_targets).
+# --write-results FILE then writes the headline tables of every step to FILE with
+# scripts/results.sh (docs/results.md is written this way). Sequences and grid runs already
 # in OUT are kept (pldvo ablate --skip_existing); the timing runs are always redone. About 25 min
 # on a quiet 2-core machine (the grid 20 of them). Each step's own tables stay in OUT (results.md
 # of every ablation).
 set -euo pipefail
-# OUT and PLDVO_KITTI are relative to the caller's folder; the default KITTI folder is ../shared.
-out=$(realpath -m "${1:-/tmp/pldvo_targets}")
+# OUT, FILE, PLDVO_KITTI and PLDVO_REAL are relative to the caller's folder; the default KITTI
+# folder is ../shared.
+out_arg=/tmp/pldvo_targets
+results_file=
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --write-results) results_file=$(realpath -m "${2:?--write-results needs a FILE}"); shift 2 ;;
+    *) out_arg=$1; shift ;;
+  esac
+done
+out=$(realpath -m "$out_arg")
+real=()
+IFS=, read -r -a real_arg <<< "${PLDVO_REAL:-}"
+for dir in "${real_arg[@]}"; do if [ -n "$dir" ]; then real+=("$(realpath -m "$dir")"); fi; done
 kitti=$(realpath -m "${PLDVO_KITTI:-$(dirname "$0")/../../shared/data/kitti00_first200}")
 cd "$(dirname "$0")/.."
 scripts/build.sh >/dev/null
@@ -77,7 +94,8 @@ echo "== 2. Real-time per-frame time, 640x480 (mapping thread, wait_for_mapping=
 "$build/experiments/benchmarks/tracking_benchmark" \
   --benchmark_filter='^Track/gauss_newton/tracking/batch:128/real_time$' 2>/dev/null |
   awk '/^Track/ { print "machine: tracking_benchmark Gauss-Newton solve", $2,
-                   "ms (quiet: 19.2-19.9)" }'
+                   "ms (quiet: 19.2-19.9)" }' | tee "$out/machine.log"
+awk '{ print $5 }' "$out/machine.log" > "$out/machine.txt"
 rm -rf "$out/timing"
 ablate --configs "$configs/points_lines.yaml" \
   --datasets "$out/seq/lowtex1,$out/seq/textured1,$out/seq/textured3" --jobs 1 \
@@ -89,7 +107,8 @@ medians "$out/timing" ms_median_tracking_thread | awk '{
 echo "== 3. Ceres and Gauss-Newton on the same problems (RPE cm/s of each trajectory; median ms"
 echo "   of one frame's solve, Gauss-Newton / Ceres)"
 datasets="$(seqs lowtex),$(seqs textured)"
-[ -f "$kitti/rgb.txt" ] && datasets="$datasets,$kitti"
+has_kitti() { [ -f "$kitti/rgb.txt" ] || [ -f "$kitti/times.txt" ]; }
+has_kitti && datasets="$datasets,$kitti"
 ablate --configs "$configs/points_lines.yaml" --datasets "$datasets" --jobs 1 \
   --skip_existing --set odometry.compare_solver=ceres --out "$out/solvers"
 awk -F, 'NR > 1 && $3 == "ok" { print $1, $8, $16 }' "$out/solvers/results.csv" |
@@ -105,12 +124,23 @@ awk -F, 'NR > 1 && $3 == "ok" { print $1, $8, $16 }' "$out/solvers/results.csv" 
   done
 
 echo "== 4. KITTI 00, first 200 frames (mapping thread)"
-if [ -f "$kitti/rgb.txt" ]; then
+if has_kitti; then
   ablate --configs "$configs/sdvo.yaml,$configs/points_lines.yaml" --datasets "$kitti" \
     --jobs 1 --skip_existing --out "$out/kitti"
   awk -F, 'NR > 1 { printf "%-13s %-9s frames %s tracked %s lost %s  RPE %s cm/s  ATE %s m\n",
     $2, $3, $4, $5, $7, $8, $10 }' "$out/kitti/results.csv"
 else
-  echo "skipped: no $kitti/rgb.txt"
+  echo "skipped: no $kitti/rgb.txt or $kitti/times.txt"
+fi
+
+echo "== 5. Real data (PLDVO_REAL; mapping thread)"
+if [ ${#real[@]} -gt 0 ]; then
+  ablate --configs "$configs/sdvo.yaml,$configs/points_lines.yaml" \
+    --datasets "$(IFS=,; echo "${real[*]}")" --jobs 1 --skip_existing --out "$out/real"
+  awk -F, 'NR > 1 { printf "%-28s %-13s %-9s frames %s tracked %s lost %s  RPE %s cm/s %s deg/s\n",
+    $1, $2, $3, $4, $5, $7, $8, $9 }' "$out/real/results.csv"
+else
+  echo "skipped: PLDVO_REAL is not set"
 fi
 echo "Tables of every step: $out/*/results.md"
+if [ -n "$results_file" ]; then scripts/results.sh "$out" "$results_file"; fi
