@@ -19,7 +19,7 @@
 
 #include "backend/depth_map_io.h"
 #include "backend/depth_mapper.h"
-#include "core/evaluation.h"
+#include "core/statistics.h"
 #include "core/wall_clock.h"
 
 namespace pldvo {

@@ -36,7 +36,7 @@
 #include "backend/reference_builder.h"
 #include "backend/tracker.h"
 #include "core/config_io.h"
-#include "core/evaluation.h"
+#include "core/statistics.h"
 #include "core/wall_clock.h"
 #include "experiments/command.h"
 #include "experiments/synthetic_pairs.h"
@@ -156,12 +156,6 @@ TrackingReference FrontendPairReference(const synthetic_pairs::FramePair& pair,
       MatchedLinesFromMatches(kept, frame.segments, static_cast<int>(keyframe.segments.size())),
       &reference);
   return reference;
-}
-
-double Mean(const std::vector<double>& values) {
-  double sum = 0.0;
-  for (double v : values) sum += v;
-  return values.empty() ? 0.0 : sum / values.size();
 }
 
 struct Mode {

@@ -18,6 +18,7 @@
 #include "backend/odometry_config.h"
 #include "core/config_io.h"
 #include "core/evaluation.h"
+#include "core/statistics.h"
 #include "core/synthetic/synthetic_sequence.h"
 #include "tests/backend/rendered_sequence.h"
 #include "tests/render_cache.h"

@@ -12,7 +12,7 @@
 
 #include "backend/odometry_config.h"
 #include "core/dataset.h"
-#include "core/evaluation.h"
+#include "core/statistics.h"
 #include "core/synthetic/synthetic_sequence.h"
 #include "tests/render_cache.h"
 #include "tests/small_lowtex_options.h"
