@@ -98,6 +98,17 @@ TEST_F(ParserRegressionTest, YamlSpellingsNextToTheGuardStillRead) {
   }
 }
 
+// OpenCV's reader took "4294967936" for the int 640 (strtol, then a cast), and rejected a
+// comment line before "---"; the yaml-cpp reader does neither.
+TEST_F(ParserRegressionTest, YamlIntegersOutOfRangeAndCommentsBeforeTheMarker) {
+  std::string text = kCameraKeys;
+  text.replace(text.find("width: 64"), 9, "width: 4294967936");
+  const std::string path = Write("camera.yaml", text);
+  EXPECT_THAT(ErrorOf([&] { ReadCameraYaml(path); }), HasSubstr(path + ":2: key 'width'"));
+  const std::string commented = Write("commented.yaml", std::string("# c\n---\n") + kCameraKeys);
+  EXPECT_EQ(ErrorOf([&] { ReadCameraYaml(commented); }), "");
+}
+
 // An empty key in a nested map made cv::FileStorage throw std::length_error
 // ("basic_string::_M_create"), which escaped without the file name (config_fuzzer). yaml-cpp
 // reads it as a null key, which core/yaml_reader.cc rejects with the line.
