@@ -16,7 +16,8 @@ namespace {
 
 using namespace dataset_util;  // NOLINT(build/namespaces): the readers' own helpers
 
-// A key of EuRoC's sensor.yaml (nested keys through `parent`, e.g. T_BS then data).
+// The entry `key` of `map` (Require(Require(root, "T_BS"), "data") for T_BS.data); missing:
+// "<path>: missing key 'T_BS.data'".
 YamlNode Require(const YamlNode& map, const std::string& key) {
   std::optional<YamlNode> node = map.Find(key);
   if (!node) {
@@ -47,7 +48,7 @@ std::vector<double> NumberList(const YamlNode& node, size_t count) {
   return numbers;
 }
 
-// A string-valued key such as camera_model; anything else is reported as `what`.
+// A name-valued key such as camera_model (a string, not a number or a list).
 std::string Name(const YamlNode& node) {
   std::string value;
   if (!node.GetString(&value))
