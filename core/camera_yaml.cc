@@ -4,12 +4,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <opencv2/core.hpp>
+#include <optional>
 #include <set>
-#include <sstream>
 #include <stdexcept>
 
-#include "core/config_io.h"
+#include "core/yaml_reader.h"
 
 namespace pldvo {
 namespace {
@@ -38,106 +37,84 @@ const std::vector<Preset>& Presets() {
   return presets;
 }
 
-std::string NodeDescription(const cv::FileNode& node) {
-  if (node.isMap()) return "a map";
-  if (node.isSeq()) return "a list";
-  if (node.isString()) return "the string '" + static_cast<std::string>(node) + "'";
-  if (node.isInt()) return "an integer";
-  if (node.isReal()) return "a number";
-  return "no value";
-}
-
+// Reads the keys of a camera.yaml's top-level map; errors name the file, the line and the key.
 class CameraYamlReader {
  public:
-  CameraYamlReader(const std::string& path, const cv::FileNode& root) : path_(path), root_(root) {}
+  explicit CameraYamlReader(const YamlNode& root) : root_(root) {}
 
-  [[noreturn]] void Fail(const std::string& key, const std::string& what) const {
-    throw std::runtime_error(path_ + ": key '" + key + "': " + what);
-  }
-
-  cv::FileNode Get(const std::string& key) const {
-    const cv::FileNode node = root_[key];
-    if (node.empty() && !node.isSeq()) {
-      // An empty list "[]" is also empty(); only a missing key is an error here.
-      bool present = false;
-      for (cv::FileNodeIterator it = root_.begin(); it != root_.end(); ++it) {
-        if ((*it).name() == key) present = true;
-      }
-      if (!present)
-        Fail(key,
-             "missing (camera.yaml needs model, width, height, fx, fy, cx, cy, "
-             "distortion)");
+  YamlNode Get(const std::string& key) const {
+    std::optional<YamlNode> node = root_.Find(key);
+    if (!node) {
+      throw std::runtime_error(root_.path() + ": key '" + key +
+                               "': missing (camera.yaml needs model, width, height, fx, fy, cx, "
+                               "cy, distortion)");
     }
-    return node;
+    return *node;
   }
 
   std::string String(const std::string& key) const {
-    const cv::FileNode node = Get(key);
-    if (!node.isString()) Fail(key, "expected a string, got " + NodeDescription(node));
-    return static_cast<std::string>(node);
+    const YamlNode node = Get(key);
+    std::string value;
+    if (!node.GetString(&value)) node.Fail("expected a string, got " + node.Describe());
+    return value;
   }
 
   int PositiveInt(const std::string& key) const {
-    const cv::FileNode node = Get(key);
-    if (!node.isInt()) Fail(key, "expected an integer, got " + NodeDescription(node));
-    const int value = static_cast<int>(node);
-    if (value <= 0) Fail(key, "must be positive, got " + std::to_string(value));
+    const YamlNode node = Get(key);
+    int value = 0;
+    if (!node.GetInt(&value)) node.Fail("expected an integer, got " + node.Describe());
+    if (value <= 0) node.Fail("must be positive, got " + std::to_string(value));
     return value;
   }
 
   double Number(const std::string& key) const {
-    const cv::FileNode node = Get(key);
-    if (!node.isInt() && !node.isReal()) {
-      Fail(key, "expected a number, got " + NodeDescription(node));
-    }
-    const double value = static_cast<double>(node);
-    if (!std::isfinite(value)) Fail(key, "must be finite");
+    const YamlNode node = Get(key);
+    double value = 0.0;
+    if (!node.GetDouble(&value)) node.Fail("expected a number, got " + node.Describe());
+    if (!std::isfinite(value)) node.Fail("must be finite");
     return value;
   }
 
   std::vector<double> Numbers(const std::string& key) const {
-    const cv::FileNode node = Get(key);
-    if (!node.isSeq()) {
-      Fail(key, "expected a list of numbers like [0.1, -0.2], got " + NodeDescription(node));
+    const YamlNode node = Get(key);
+    if (!node.IsList()) {
+      node.Fail("expected a list of numbers like [0.1, -0.2], got " + node.Describe());
     }
     std::vector<double> values;
-    for (cv::FileNodeIterator it = node.begin(); it != node.end(); ++it) {
-      const cv::FileNode item = *it;
-      if (!item.isInt() && !item.isReal()) {
-        Fail(key, "element " + std::to_string(values.size()) + " is " + NodeDescription(item) +
-                      ", expected a number");
+    for (const YamlNode& item : node.Items()) {
+      double value = 0.0;
+      if (!item.GetDouble(&value)) {
+        item.Fail("element " + std::to_string(values.size()) + " is " + item.Describe() +
+                  ", expected a number");
       }
-      values.push_back(static_cast<double>(item));
+      values.push_back(value);
     }
     return values;
   }
 
+  [[noreturn]] void Fail(const std::string& key, const std::string& what) const {
+    Get(key).Fail(what);
+  }
+
  private:
-  std::string path_;
-  cv::FileNode root_;
+  YamlNode root_;
 };
 
 }  // namespace
 
 std::unique_ptr<CameraModel> ReadCameraYaml(const std::string& path) {
-  cv::FileStorage storage;
-  OpenYamlForReading(path, &storage);
-  const cv::FileNode root = storage.root();
-  if (!root.isMap()) throw std::runtime_error(path + ": expected a map of camera keys");
-
+  const YamlNode root = YamlNode::ReadFile(path);
+  if (!root.IsMap()) root.FailAtLine("expected a map of camera keys, got " + root.Describe());
   static const std::set<std::string> kKeys = {"model", "width", "height", "fx",
                                               "fy",    "cx",    "cy",     "distortion"};
-  std::set<std::string> seen;
-  for (cv::FileNodeIterator it = root.begin(); it != root.end(); ++it) {
-    const std::string key = (*it).name();
-    if (!kKeys.count(key)) {
-      throw std::runtime_error(path + ": unknown key '" + key +
-                               "' (valid: model, width, height, fx, fy, cx, cy, distortion)");
+  for (const YamlNode& entry : root.Entries()) {  // unique (YamlNode::ReadFile checks)
+    if (!kKeys.count(entry.name())) {
+      entry.FailAtLine("unknown key '" + entry.name() +
+                       "' (valid: model, width, height, fx, fy, cx, cy, distortion)");
     }
-    if (!seen.insert(key).second) throw std::runtime_error(path + ": duplicate key '" + key + "'");
   }
 
-  const CameraYamlReader reader(path, root);
+  const CameraYamlReader reader(root);
   const std::string model = reader.String("model");
   if (model != "pinhole" && model != "radtan" && model != "fov") {
     reader.Fail("model", "unknown model '" + model + "' (valid: pinhole, radtan, fov)");
@@ -181,7 +158,7 @@ void WriteCameraYaml(const CameraModel& camera, const std::string& path) {
       std::snprintf(buffer, sizeof(buffer), "%.*g", precision, value);
       if (std::strtod(buffer, nullptr) == value) break;
     }
-    // A real-looking spelling: cv::FileStorage reads "19444444444444444" as an int and wraps it.
+    // A real-looking spelling: OpenCV's reader takes "19444444444444444" for an int and wraps it.
     std::string text = buffer;
     if (text.find_first_of(".eE") == std::string::npos) text += ".0";
     return text;

@@ -1,4 +1,5 @@
-// camera.yaml: the calibration file, in the YAML that cv::FileStorage reads and writes:
+// camera.yaml: the calibration file (read by core/yaml_reader.h; OpenCV's FileStorage reads it
+// too):
 //   %YAML:1.0
 //   ---
 //   model: pinhole        # pinhole | radtan | fov
@@ -23,7 +24,8 @@
 
 namespace pldvo {
 
-// Reads a camera.yaml; throws std::runtime_error naming the file and the missing or bad key.
+// Reads a camera.yaml; throws std::runtime_error naming the file, the line and the missing or bad
+// key.
 std::unique_ptr<CameraModel> ReadCameraYaml(const std::string& path);
 // Writes a camera.yaml that ReadCameraYaml reads back exactly.
 void WriteCameraYaml(const CameraModel& camera, const std::string& path);

@@ -7,9 +7,10 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
-#include <opencv2/core.hpp>
 #include <set>
 #include <sstream>
+
+#include "core/yaml_reader.h"
 
 namespace pldvo {
 namespace {
@@ -39,8 +40,7 @@ std::string LeafName(const std::string& key) {
   return dot == std::string::npos ? key : key.substr(dot + 1);
 }
 
-// The shortest decimal that reads back to exactly `value` (YAML spellings for inf and nan, which
-// cv::FileStorage reads as reals).
+// The shortest decimal that reads back to exactly `value` (YAML spellings for inf and nan).
 std::string FormatDouble(double value) {
   if (std::isnan(value)) return ".nan";
   if (std::isinf(value)) return value > 0 ? ".inf" : "-.inf";
@@ -50,7 +50,7 @@ std::string FormatDouble(double value) {
     if (std::strtod(buffer, nullptr) == value) break;
   }
   std::string text = buffer;
-  // Keep a real-looking spelling so the YAML type is "real" (cv reads "20" as an integer).
+  // Keep a real-looking spelling, so that OpenCV's reader too sees a real ("20" is an integer).
   if (text.find_first_of(".eE") == std::string::npos) text += ".0";
   return text;
 }
@@ -227,7 +227,7 @@ std::string SetFromText(const ConfigEntry& entry, const std::string& text) {
       return ParseDouble(text, value) ? "" : "expected a number, got '" + text + "'";
     }
     std::string operator()(std::string* value) const {
-      // cv::FileStorage reads no control character back (WriteConfigYaml must round-trip).
+      // WriteConfigYaml must round-trip, and YAML allows no raw control character in a scalar.
       for (char c : text) {
         if (static_cast<unsigned char>(c) < 0x20) return "control characters are not allowed";
       }
@@ -269,92 +269,66 @@ std::string SetFromText(const ConfigEntry& entry, const std::string& text) {
 
 // ---- YAML reading ----
 
-std::string DescribeNode(const cv::FileNode& node) {
-  if (node.isMap()) return "a map";
-  if (node.isSeq()) return "a list";
-  if (node.isString()) return "the string '" + static_cast<std::string>(node) + "'";
-  if (node.isInt()) return "the integer " + std::to_string(static_cast<int>(node));
-  if (node.isReal()) return "the number " + FormatDouble(static_cast<double>(node));
-  return "no value";
-}
-
-bool NodeIsNumber(const cv::FileNode& node) { return node.isInt() || node.isReal(); }
-
 // Sets an entry from a YAML node; returns "" or what is wrong.
-std::string SetFromNode(const ConfigEntry& entry, const cv::FileNode& node) {
+std::string SetFromNode(const ConfigEntry& entry, const YamlNode& node) {
   struct Visitor {
-    const cv::FileNode& node;
+    const YamlNode& node;
     std::string operator()(bool* value) const {
-      if (node.isString() && ParseBool(static_cast<std::string>(node), value)) return "";
-      if (node.isInt() && (static_cast<int>(node) == 0 || static_cast<int>(node) == 1)) {
-        *value = static_cast<int>(node) == 1;
-        return "";
-      }
-      return "expected true or false, got " + DescribeNode(node);
+      return node.GetBool(value) ? "" : "expected true or false, got " + node.Describe();
     }
     std::string operator()(int* value) const {
-      if (!node.isInt()) return "expected an integer, got " + DescribeNode(node);
-      *value = static_cast<int>(node);
-      return "";
+      return node.GetInt(value) ? "" : "expected an integer, got " + node.Describe();
     }
     std::string operator()(double* value) const {
-      if (!NodeIsNumber(node)) return "expected a number, got " + DescribeNode(node);
-      *value = static_cast<double>(node);
-      return "";
+      return node.GetDouble(value) ? "" : "expected a number, got " + node.Describe();
     }
     std::string operator()(std::string* value) const {
-      if (!node.isString()) {
-        return "expected a string (quote it: \"...\"), got " + DescribeNode(node);
-      }
-      *value = static_cast<std::string>(node);
-      return "";
+      return node.GetString(value)
+                 ? ""
+                 : "expected a string (quote it: \"...\"), got " + node.Describe();
     }
     std::string operator()(std::vector<double>* value) const {
-      if (!node.isSeq()) return "expected a list of numbers like [1, 2], got " + DescribeNode(node);
+      if (!node.IsList()) return "expected a list of numbers like [1, 2], got " + node.Describe();
       std::vector<double> values;
-      for (cv::FileNodeIterator it = node.begin(); it != node.end(); ++it) {
-        const cv::FileNode item = *it;
-        if (!NodeIsNumber(item)) {
+      for (const YamlNode& item : node.Items()) {
+        double number = 0.0;
+        if (!item.GetDouble(&number)) {
           return "expected a list of numbers, element " + std::to_string(values.size()) + " is " +
-                 DescribeNode(item);
+                 item.Describe();
         }
-        values.push_back(static_cast<double>(item));
+        values.push_back(number);
       }
       *value = values;
       return "";
     }
     std::string operator()(const ChoiceRef& choice) const {
-      if (!node.isString()) {
-        return "expected one of " + Join(choice.names, ", ") + ", got " + DescribeNode(node);
+      std::string name;
+      if (!node.GetString(&name)) {
+        return "expected one of " + Join(choice.names, ", ") + ", got " + node.Describe();
       }
-      return SetFromText(ConfigEntry{"", "", choice}, static_cast<std::string>(node));
+      return SetFromText(ConfigEntry{"", "", choice}, name);
     }
   };
   return std::visit(Visitor{node}, entry.field);
 }
 
-void ReadMap(const cv::FileNode& map, const std::string& prefix, const ConfigSchema& schema,
-             const std::string& path) {
-  auto fail = [&path](const std::string& message) {
-    throw std::runtime_error(path + ": " + message);
-  };
-  std::set<std::string> seen;
-  for (cv::FileNodeIterator it = map.begin(); it != map.end(); ++it) {
-    const cv::FileNode node = *it;
+// Keys are the map's dotted prefix plus the file's key (itself possibly dotted: "a.b: 1" at the
+// top level sets a.b).
+void ReadMap(const YamlNode& map, const std::string& prefix, const ConfigSchema& schema) {
+  for (const YamlNode& node : map.Entries()) {
     const std::string key = prefix + node.name();
-    if (!seen.insert(node.name()).second) fail("duplicate key '" + key + "'");
     if (IsSection(schema, key)) {
-      if (!node.isMap()) {
-        fail("key '" + key + "' is a section and takes a map of its keys (" +
-             Join(KeysAtLevel(schema, key), ", ") + "), got " + DescribeNode(node));
+      if (!node.IsMap()) {
+        node.FailAtLine("key '" + key + "' is a section and takes a map of its keys (" +
+                        Join(KeysAtLevel(schema, key), ", ") + "), got " + node.Describe());
       }
-      ReadMap(node, key + ".", schema, path);
+      ReadMap(node, key + ".", schema);
       continue;
     }
     const ConfigEntry* entry = FindEntry(schema, key);
-    if (entry == nullptr) fail(UnknownKeyMessage(schema, key));
+    if (entry == nullptr) node.FailAtLine(UnknownKeyMessage(schema, key));
     const std::string error = SetFromNode(*entry, node);
-    if (!error.empty()) fail("key '" + key + "': " + error);
+    if (!error.empty()) node.FailAtLine("key '" + key + "': " + error);
   }
 }
 
@@ -366,89 +340,13 @@ void WriteComment(const std::string& doc, const std::string& indent, std::ostrin
   while (std::getline(lines, line)) *out << indent << "# " << line << "\n";
 }
 
-// cv::FileStorage (OpenCV 4.6 persistence_yml.cpp, YAMLParser::parse) loops forever when a
-// second YAML document starts with '-' other than "---" ("a: 1\n...\n- 1"), which an indented
-// root map ended by a line at column 0 also reaches ("  a: 1\nb\n-"). Our files are one map,
-// so reject what leads to a second document: a second "---", a "...", keys on the "---" line,
-// and an indented first key. Found by tests/fuzz/camera_yaml_fuzzer (docs/reliability.md).
-void RejectMultipleDocuments(const std::string& text, const std::string& path) {
-  std::istringstream lines(text);
-  std::string line;
-  int line_number = 0;
-  bool seen_marker = false, seen_content = false;
-  auto fail = [&](const std::string& what) {
-    throw std::runtime_error(path + ":" + std::to_string(line_number) + ": " + what);
-  };
-  while (std::getline(lines, line)) {
-    ++line_number;
-    const size_t first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
-    if (!seen_content && !seen_marker && line[0] == '%') continue;  // a directive
-    if (line.compare(0, 3, "---") == 0) {
-      if (seen_marker || seen_content) fail("only one YAML document is supported (second '---')");
-      const size_t rest = line.find_first_not_of(" \t\r", 3);
-      if (rest != std::string::npos && (rest == 3 || line[rest] != '#')) {
-        fail("put the keys on the lines after '---'");
-      }
-      seen_marker = true;
-      continue;
-    }
-    if (line.compare(0, 3, "...") == 0) fail("the document end marker '...' is not supported");
-    if (!seen_content && first != 0) fail("the top-level keys must start at column 0");
-    seen_content = true;
-  }
-}
-
 }  // namespace
 
-void OpenYamlForReading(const std::string& path, cv::FileStorage* storage) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw std::runtime_error(path + ": cannot open the file for reading");
-  std::ostringstream content;
-  content << file.rdbuf();
-  std::string text = content.str();
-  RejectMultipleDocuments(text, path);
-  // cv::FileStorage needs the "%YAML" directive to recognise YAML in memory; add it if missing.
-  int added_lines = 0;
-  if (text.compare(0, 5, "%YAML") != 0) {
-    if (text.compare(0, 3, "---") == 0) {
-      text = "%YAML:1.0\n" + text;
-      added_lines = 1;
-    } else {
-      text = "%YAML:1.0\n---\n" + text;
-      added_lines = 2;
-    }
-  }
-  try {
-    storage->open(text,
-                  cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
-  } catch (const cv::Exception& error) {
-    // Parse errors carry "(line): message" in error.func.
-    std::string message = error.func;
-    int line = 0;
-    char rest[512] = {0};
-    if (std::sscanf(error.func.c_str(), "(%d): %511[^\n]", &line, rest) == 2) {
-      throw std::runtime_error(path + ":" + std::to_string(line - added_lines) +
-                               ": YAML syntax error: " + rest);
-    }
-    throw std::runtime_error(path + ": YAML syntax error: " + error.err + " " + message);
-  } catch (const std::exception& error) {
-    // OpenCV 4.6's parser also lets std::length_error out (an empty key "  :" in a nested map).
-    throw std::runtime_error(path + ": YAML syntax error: " + error.what());
-  }
-  if (!storage->isOpened()) throw std::runtime_error(path + ": cannot parse the file as YAML");
-}
-
 void LoadConfigYaml(const std::string& path, const ConfigSchema& schema) {
-  cv::FileStorage storage;
-  OpenYamlForReading(path, &storage);
-  const cv::FileNode root = storage.root();
-  if (root.empty() || root.isNone()) return;  // an empty file keeps every default
-  if (!root.isMap()) {
-    throw std::runtime_error(path + ": the top level must be a map of keys, got " +
-                             DescribeNode(root));
-  }
-  ReadMap(root, "", schema, path);
+  const YamlNode root = YamlNode::ReadFile(path);
+  if (root.IsNull()) return;  // an empty file keeps every default
+  if (!root.IsMap()) root.FailAtLine("the top level must be a map of keys, got " + root.Describe());
+  ReadMap(root, "", schema);
 }
 
 void ApplyOverrides(const std::vector<std::string>& overrides, const ConfigSchema& schema) {

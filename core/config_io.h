@@ -12,7 +12,8 @@
 // error naming the key and the closest valid keys; so is a value of the wrong type or an enum
 // name that does not exist (the message lists the valid names). YAML files hold sections as
 // nested maps; bool as true/false, enums by name, vectors as [1, 2, 3]; overrides write vectors
-// as "1,2,3". Files read through cv::FileStorage; the "%YAML:1.0" first line is optional.
+// as "1,2,3". Files are read by core/yaml_reader.h (errors name the line); the "%YAML:1.0" first
+// line that the writer puts is optional.
 //
 // The templates below only flatten a struct into a ConfigSchema (typed pointers to its fields
 // with their dotted keys and docs); everything else is the non-template core in config_io.cc.
@@ -27,10 +28,6 @@
 #include <vector>
 
 #include "core/options.h"
-
-namespace cv {
-class FileStorage;
-}  // namespace cv
 
 namespace pldvo {
 
@@ -121,7 +118,7 @@ ConfigSchema MakeConfigSchema(Options* options) {
 }
 
 // ---- Non-template core (config_io.cc) ----
-// Throws std::runtime_error naming the file and the dotted key.
+// Throws std::runtime_error naming the file, the line and the dotted key.
 void LoadConfigYaml(const std::string& path, const ConfigSchema& schema);
 // Throws std::invalid_argument naming the override and the key.
 void ApplyOverrides(const std::vector<std::string>& overrides, const ConfigSchema& schema);
@@ -129,10 +126,6 @@ std::string ConfigToString(const ConfigSchema& schema);
 // Throws std::runtime_error when the file cannot be written.
 void WriteConfigYaml(const ConfigSchema& schema, const std::string& path);
 std::string DescribeConfig(const ConfigSchema& schema);
-
-// Opens a YAML file for reading with cv::FileStorage (prepending "%YAML:1.0" when the file lacks
-// it); throws std::runtime_error naming the file (and the line of a syntax error).
-void OpenYamlForReading(const std::string& path, cv::FileStorage* storage);
 
 // ---- Templates over any struct with VisitFields ----
 template <class Options>

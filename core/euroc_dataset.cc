@@ -3,91 +3,57 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
-#include <map>
-#include <sstream>
+#include <optional>
 #include <stdexcept>
+#include <vector>
 
 #include "core/camera_yaml.h"
 #include "core/dataset_util.h"
+#include "core/yaml_reader.h"
 
 namespace pldvo {
 namespace {
 
 using namespace dataset_util;  // NOLINT(build/namespaces): the readers' own helpers
 
-// The few keys of an EuRoC sensor.yaml (not cv::FileStorage YAML: no %YAML header, T_BS as a
-// plain map): top-level `key: value` pairs, bracketed lists possibly spanning lines, and the
-// `data:` list nested under `T_BS:`. Values keep the line they start on for error messages.
-struct YamlValue {
-  std::string text;  // scalar, or the inside of [...]
-  int line_number = 0;
-};
-
-std::map<std::string, YamlValue> ReadSensorYaml(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open file");
-  std::map<std::string, YamlValue> values;
-  std::string line, parent, open_key;
-  int line_number = 0;
-  while (std::getline(in, line)) {
-    ++line_number;
-    const size_t hash = line.find('#');
-    if (hash != std::string::npos) line.resize(hash);
-    if (!open_key.empty()) {  // continuing a [...] list
-      const size_t close = line.find(']');
-      values[open_key].text += " " + line.substr(0, close);
-      if (close != std::string::npos) open_key.clear();
-      continue;
-    }
-    const size_t colon = line.find(':');
-    if (colon == std::string::npos) continue;
-    const size_t indent = line.find_first_not_of(" \t");
-    std::string key = line.substr(indent, colon - indent);
-    while (!key.empty() && (key.back() == ' ' || key.back() == '\t')) key.pop_back();
-    if (indent == 0) parent = key;
-    const std::string full_key = indent == 0 ? key : parent + "." + key;
-    std::string value = line.substr(colon + 1);
-    const size_t open = value.find('[');
-    YamlValue entry;
-    entry.line_number = line_number;
-    if (open != std::string::npos) {
-      const size_t close = value.find(']', open);
-      entry.text =
-          value.substr(open + 1, close == std::string::npos ? std::string::npos : close - open - 1);
-      if (close == std::string::npos) open_key = full_key;
-    } else {
-      const size_t first = value.find_first_not_of(" \t\r");
-      const size_t last = value.find_last_not_of(" \t\r");
-      entry.text = first == std::string::npos ? "" : value.substr(first, last - first + 1);
-    }
-    values[full_key] = entry;
+// The entry `key` of `map` (Require(Require(root, "T_BS"), "data") for T_BS.data); missing:
+// "<path>: missing key 'T_BS.data'".
+YamlNode Require(const YamlNode& map, const std::string& key) {
+  std::optional<YamlNode> node = map.Find(key);
+  if (!node) {
+    const std::string dotted = map.key().empty() ? key : map.key() + "." + key;
+    throw std::runtime_error(map.path() + ": missing key '" + dotted + "'");
   }
-  return values;
+  return *node;
 }
 
-const YamlValue& Require(const std::map<std::string, YamlValue>& values, const std::string& key,
-                         const std::string& path) {
-  const auto it = values.find(key);
-  if (it == values.end()) throw std::runtime_error(path + ": missing key '" + key + "'");
-  return it->second;
-}
-
-std::vector<double> NumberList(const YamlValue& value, const std::string& path, size_t count,
-                               const std::string& key) {
-  std::string text = value.text;
-  for (char& c : text) {
-    if (c == ',') c = ' ';
+// A list of `count` finite numbers, e.g. T_BS.data: [r00, r01, r02, t0, ...] (row-major 4x4).
+std::vector<double> NumberList(const YamlNode& node, size_t count) {
+  if (!node.IsList()) {
+    node.FailAtLine(node.key() + " must be a list of numbers like [1, 2], got " + node.Describe());
   }
-  std::istringstream fields(text);
   std::vector<double> numbers;
-  std::string field;
-  while (fields >> field) numbers.push_back(ParseDouble(field, path, value.line_number));
+  for (const YamlNode& item : node.Items()) {
+    double value = 0.0;
+    if (!item.GetDouble(&value) || !std::isfinite(value)) {
+      item.FailAtLine(node.key() + " element " + std::to_string(numbers.size()) + " is " +
+                      item.Describe() + ", expected a finite number");
+    }
+    numbers.push_back(value);
+  }
   if (numbers.size() != count) {
-    FailAt(path, value.line_number,
-           key + " needs " + std::to_string(count) + " numbers, found " +
-               std::to_string(numbers.size()));
+    node.FailAtLine(node.key() + " needs " + std::to_string(count) + " numbers, found " +
+                    std::to_string(numbers.size()));
   }
   return numbers;
+}
+
+// A name-valued key such as camera_model (a string, not a number or a list).
+std::string Name(const YamlNode& node) {
+  std::string value;
+  if (!node.GetString(&value))
+    node.FailAtLine(node.key() + " must be a name, got " + node.Describe());
+  return value;
 }
 
 struct EurocCamera {
@@ -95,32 +61,36 @@ struct EurocCamera {
   SE3 body_from_cam;
 };
 
+// sensor.yaml is plain YAML (EuRoC's own files have no "%YAML" line; the OpenCV-style
+// "%YAML:1.0" and "!!opencv-matrix" of other tools' copies read as well). Keys other than the
+// ones below (sensor_type, comment, rate_hz, T_BS.rows, ...) are ignored.
 EurocCamera ReadEurocCamera(const std::string& path) {
-  const auto values = ReadSensorYaml(path);
+  const YamlNode root = YamlNode::ReadFile(path);
+  if (!root.IsMap() && !root.IsNull()) {
+    root.FailAtLine("expected a map of sensor keys, got " + root.Describe());
+  }
   EurocCamera camera;
-  const std::vector<double> t_bs =
-      NumberList(Require(values, "T_BS.data", path), path, 16, "T_BS.data");
+  const YamlNode t_bs_node = Require(Require(root, "T_BS"), "data");
+  const std::vector<double> t_bs = NumberList(t_bs_node, 16);
   Eigen::Matrix3d rotation;
   rotation << t_bs[0], t_bs[1], t_bs[2], t_bs[4], t_bs[5], t_bs[6], t_bs[8], t_bs[9], t_bs[10];
-  const int t_line = Require(values, "T_BS.data", path).line_number;
   if ((rotation.transpose() * rotation - Eigen::Matrix3d::Identity()).norm() > 1e-4 ||
       rotation.determinant() < 0.0) {
-    FailAt(path, t_line, "T_BS rotation is not orthonormal");
+    t_bs_node.FailAtLine("T_BS rotation is not orthonormal");
   }
   camera.body_from_cam = SE3(rotation, Eigen::Vector3d(t_bs[3], t_bs[7], t_bs[11]));
 
-  const std::vector<double> resolution =
-      NumberList(Require(values, "resolution", path), path, 2, "resolution");
-  const std::vector<double> intrinsics =
-      NumberList(Require(values, "intrinsics", path), path, 4, "intrinsics");
-  const YamlValue& projection = Require(values, "camera_model", path);
-  if (projection.text != "pinhole") {
-    FailAt(path, projection.line_number, "unsupported camera_model '" + projection.text + "'");
+  const YamlNode resolution_node = Require(root, "resolution");
+  const std::vector<double> resolution = NumberList(resolution_node, 2);
+  const YamlNode intrinsics_node = Require(root, "intrinsics");
+  const std::vector<double> intrinsics = NumberList(intrinsics_node, 4);
+  const YamlNode projection = Require(root, "camera_model");
+  if (Name(projection) != "pinhole") {
+    projection.FailAtLine("unsupported camera_model '" + Name(projection) + "'");
   }
   for (double side : resolution) {  // casting a double beyond int's range is undefined
     if (!(side >= 1.0 && side <= std::numeric_limits<int>::max()) || side != std::floor(side)) {
-      FailAt(path, Require(values, "resolution", path).line_number,
-             "resolution must be two positive integers");
+      resolution_node.FailAtLine("resolution must be two positive integers");
     }
   }
   PinholeCamera pinhole;
@@ -130,25 +100,24 @@ EurocCamera ReadEurocCamera(const std::string& path) {
   pinhole.fy = intrinsics[1];
   pinhole.cx = intrinsics[2];
   pinhole.cy = intrinsics[3];
-  const YamlValue& distortion_model = Require(values, "distortion_model", path);
+  const YamlNode distortion_node = Require(root, "distortion_model");
+  const std::string distortion_model = Name(distortion_node);
   std::string model;
   std::vector<double> distortion;
-  if (distortion_model.text == "radial-tangential" || distortion_model.text == "radtan") {
+  if (distortion_model == "radial-tangential" || distortion_model == "radtan") {
     model = "radtan";
-    distortion = NumberList(Require(values, "distortion_coefficients", path), path, 4,
-                            "distortion_coefficients");
+    distortion = NumberList(Require(root, "distortion_coefficients"), 4);
     distortion.push_back(0.0);  // k3
-  } else if (distortion_model.text == "none") {
+  } else if (distortion_model == "none") {
     model = "pinhole";
   } else {
-    FailAt(path, distortion_model.line_number,
-           "unsupported distortion_model '" + distortion_model.text +
-               "' (supported: radial-tangential, none)");
+    distortion_node.FailAtLine("unsupported distortion_model '" + distortion_model +
+                               "' (supported: radial-tangential, none)");
   }
   try {
     camera.model = MakeCameraModel(model, pinhole, distortion);
   } catch (const std::exception& e) {
-    FailAt(path, Require(values, "intrinsics", path).line_number, e.what());
+    intrinsics_node.FailAtLine(e.what());
   }
   return camera;
 }

@@ -1,6 +1,6 @@
 #include "core/evaluation.h"
 
-#include <Eigen/SVD>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -38,49 +38,38 @@ int NearestPose(const Trajectory& trajectory, double t) {
 
 }  // namespace
 
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  double median = values[mid];
-  if (values.size() % 2 == 0) {
-    median = 0.5 * (median + *std::max_element(values.begin(), values.begin() + mid));
-  }
-  return median;
-}
-
 Sim3Alignment AlignUmeyama(const std::vector<Eigen::Vector3d>& src,
                            const std::vector<Eigen::Vector3d>& dst, bool with_scale) {
   if (src.size() != dst.size()) throw std::invalid_argument("AlignUmeyama: sizes differ");
   if (src.size() < 3) throw std::invalid_argument("AlignUmeyama: needs at least 3 point pairs");
-  const double n = static_cast<double>(src.size());
-  Eigen::Vector3d mean_src = Eigen::Vector3d::Zero(), mean_dst = Eigen::Vector3d::Zero();
-  for (size_t i = 0; i < src.size(); ++i) {
-    mean_src += src[i];
-    mean_dst += dst[i];
+  const Eigen::Index n = static_cast<Eigen::Index>(src.size());
+  Eigen::Matrix<double, 3, Eigen::Dynamic> src_points(3, n), dst_points(3, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    src_points.col(i) = src[i];
+    dst_points.col(i) = dst[i];
   }
-  mean_src /= n;
-  mean_dst /= n;
-  // sigma_src^2 (eq. 36) and the cross-covariance Sigma_xy (eq. 38), x = src, y = dst.
-  double src_var = 0.0;
-  Eigen::Matrix3d cross_cov = Eigen::Matrix3d::Zero();
-  for (size_t i = 0; i < src.size(); ++i) {
-    const Eigen::Vector3d src_centred = src[i] - mean_src;
-    src_var += src_centred.squaredNorm();
-    cross_cov += (dst[i] - mean_dst) * src_centred.transpose();
+  // Umeyama divides by sigma_src^2 (eq. 42), which is 0 when every source point is the same.
+  Eigen::Vector3d mean_src = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& point : src) mean_src += point;
+  mean_src /= static_cast<double>(n);
+  double src_spread = 0.0;  // n sigma_src^2
+  for (const Eigen::Vector3d& point : src) src_spread += (point - mean_src).squaredNorm();
+  if (!(src_spread > 0.0)) {
+    throw std::invalid_argument("AlignUmeyama: all source points coincide");
   }
-  src_var /= n;
-  cross_cov /= n;
-  if (!(src_var > 0.0)) throw std::invalid_argument("AlignUmeyama: all source points coincide");
-  // Sigma_xy = U D V^T; R = U S V^T with S = diag(1, 1, det(U) det(V)) (eqs. 39-40).
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(cross_cov, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Vector3d s = Eigen::Vector3d::Ones();
-  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0.0) s(2) = -1.0;
+  // Eqs. 39-42, with S = diag(1, 1, -1) when det(U) det(V) < 0 so that R is a proper rotation.
+  // The SE(3) solution carries R alone; the Sim(3) one returns s R (the same R: the same SVD),
+  // so s = tr(R^T s R) / 3, which stays defined when s = 0 (every dst point the same).
+  const Eigen::Matrix4d rigid = Eigen::umeyama(src_points, dst_points, /*with_scaling=*/false);
   Sim3Alignment alignment;
-  alignment.rotation = svd.matrixU() * s.asDiagonal() * svd.matrixV().transpose();
-  // c = tr(D S) / sigma_src^2 (eq. 42); t = mu_dst - c R mu_src (eq. 41).
-  alignment.scale = with_scale ? svd.singularValues().dot(s) / src_var : 1.0;
-  alignment.translation = mean_dst - alignment.scale * alignment.rotation * mean_src;
+  alignment.rotation = rigid.topLeftCorner<3, 3>();
+  alignment.translation = rigid.topRightCorner<3, 1>();
+  if (with_scale) {
+    const Eigen::Matrix4d similarity = Eigen::umeyama(src_points, dst_points, true);
+    alignment.scale =
+        (alignment.rotation.transpose() * similarity.topLeftCorner<3, 3>()).trace() / 3.0;
+    alignment.translation = similarity.topRightCorner<3, 1>();
+  }
   return alignment;
 }
 

@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+// Median and Mean: core/statistics.h (included here for the callers that long found them here).
+#include "core/statistics.h"
 #include "core/trajectory_io.h"
 
 namespace pldvo {
@@ -23,9 +25,6 @@ struct Sim3Alignment {
     return scale * (rotation * p_src) + translation;
   }
 };
-
-// The median, the mean of the two middle values for an even count; 0 for no values.
-double Median(std::vector<double> values);
 
 // The closed-form least-squares similarity (Umeyama, PAMI 1991, eqs. 40-42) minimising
 // sum_i |dst_i - (s R src_i + t)|^2; with_scale = false fixes s = 1 (SE(3) alignment).

@@ -15,7 +15,7 @@
 
 #include "core/camera_yaml.h"
 #include "core/dataset_util.h"
-#include "core/evaluation.h"
+#include "core/statistics.h"
 
 namespace pldvo {
 namespace {

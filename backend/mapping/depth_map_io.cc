@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "core/evaluation.h"
+#include "core/statistics.h"
 
 namespace pldvo {
 

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/statistics.h"
 #include "residuals/covariance_models.h"
 
 namespace pldvo {
@@ -217,8 +218,7 @@ int RemoveLineOutliers(const SE3& cur_from_ref, double max_median_px, TrackingRe
   for (int e = 0; e < num_edges; ++e) {
     std::vector<double>& d = distances[e];
     if (d.empty()) continue;
-    std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-    if (d[d.size() / 2] <= max_median_px) continue;
+    if (Median(d) <= max_median_px) continue;
     ++removed;
     for (TrackingReferenceLevel& level : reference->levels) {
       if (e < static_cast<int>(level.lines_in_cur.size())) level.lines_in_cur[e].matched = false;

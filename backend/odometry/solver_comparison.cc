@@ -6,6 +6,7 @@
 #include <exception>
 
 #include "core/evaluation.h"
+#include "core/statistics.h"
 
 namespace pldvo {
 namespace {

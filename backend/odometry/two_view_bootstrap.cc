@@ -19,7 +19,7 @@
 
 #include "backend/mapping/depth_map_io.h"
 #include "backend/mapping/depth_mapper.h"
-#include "core/evaluation.h"
+#include "core/statistics.h"
 #include "core/wall_clock.h"
 
 namespace pldvo {

@@ -37,6 +37,7 @@
 
 #include "core/dataset.h"
 #include "core/evaluation.h"
+#include "core/statistics.h"
 #include "core/trajectory_io.h"
 #include "core/trajectory_svg.h"
 #include "experiments/cli/command.h"

@@ -36,7 +36,7 @@
 #include "backend/odometry/reference_builder.h"
 #include "backend/tracking/tracker.h"
 #include "core/config_io.h"
-#include "core/evaluation.h"
+#include "core/statistics.h"
 #include "core/wall_clock.h"
 #include "experiments/cli/command.h"
 #include "experiments/evaluation/line_match_ground_truth.h"
@@ -156,12 +156,6 @@ TrackingReference FrontendPairReference(const synthetic_pairs::FramePair& pair,
       MatchedLinesFromMatches(kept, frame.segments, static_cast<int>(keyframe.segments.size())),
       &reference);
   return reference;
-}
-
-double Mean(const std::vector<double>& values) {
-  double sum = 0.0;
-  for (double v : values) sum += v;
-  return values.empty() ? 0.0 : sum / values.size();
 }
 
 struct Mode {

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "core/random_draws.h"
+#include "core/statistics.h"
 
 namespace pldvo {
 namespace {
@@ -200,13 +201,8 @@ EdgeBAErrors ComputeEdgeBAErrors(const EdgeBASimulation& simulation,
     angles.push_back(angle);
     ++errors.num_lines;
   }
-  auto median = [](std::vector<double> values) {
-    if (values.empty()) return 0.0;
-    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-    return values[values.size() / 2];
-  };
-  errors.line_distance_median_m = median(distances);
-  errors.line_angle_median_deg = median(angles) * 180.0 / M_PI;
+  errors.line_distance_median_m = Median(distances);
+  errors.line_angle_median_deg = Median(angles) * 180.0 / M_PI;
   errors.line_distance_rmse_m = Rms(distance_sq, errors.num_lines);
   errors.line_angle_rmse_deg = Rms(angle_sq, errors.num_lines) * 180.0 / M_PI;
   return errors;

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "core/random_draws.h"
+#include "core/statistics.h"
 #include "frontend/line_segment.h"
 #include "residuals/covariance_models.h"
 
@@ -195,12 +196,8 @@ DepthErrorStats EvaluateDepthMap(const SemiDenseDepthMap& map, const cv::Mat& gt
   DepthErrorStats stats;
   stats.count = static_cast<int>(rel.size());
   if (rel.empty()) return stats;
-  auto median = [](std::vector<double> v) {
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    return v[v.size() / 2];
-  };
-  stats.median_rel_error = median(rel);
-  stats.median_nees = median(nees);
+  stats.median_rel_error = Median(rel);
+  stats.median_nees = Median(nees);
   for (size_t k = 0; k < rel.size(); ++k) {
     stats.mean_rel_error += rel[k] / rel.size();
     stats.mean_nees += nees[k] / nees.size();
@@ -233,9 +230,7 @@ double MedianInverseDepthRatio(const SemiDenseDepthMap& map, const cv::Mat& gt_i
       if (gt > 0.0 && map.idepth(i) > 0.0) ratios.push_back(gt / map.idepth(i));
     }
   }
-  if (ratios.empty()) return 0.0;
-  std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
-  return ratios[ratios.size() / 2];
+  return Median(std::move(ratios));  // 0 when no pixel has both depths
 }
 
 cv::Mat ContinuousDepthMask(const cv::Mat& gt_idepth, int radius, double max_rel_step) {

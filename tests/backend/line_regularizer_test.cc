@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/random_draws.h"
+#include "core/statistics.h"
 #include "frontend/line_segment.h"
 
 namespace pldvo {
@@ -68,8 +69,7 @@ double MedianRelError(const EdgeCase& edge, const SemiDenseDepthMap& map) {
     const int index = map.Index(edge.line.pixels[i].x(), edge.line.pixels[i].y());
     errors.push_back(std::abs(map.idepth(index) - edge.gt_idepth[i]) / edge.gt_idepth[i]);
   }
-  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
-  return errors[errors.size() / 2];
+  return Median(errors);
 }
 
 TEST(LineRegularizerTest, RecoversKnownLinesAndRejectsOutliers) {

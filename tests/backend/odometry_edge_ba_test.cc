@@ -19,6 +19,7 @@
 #include "core/config_io.h"
 #include "core/evaluation.h"
 #include "experiments/synthetic/synthetic_sequence.h"
+#include "core/statistics.h"
 #include "tests/backend/rendered_sequence.h"
 #include "tests/render_cache.h"
 

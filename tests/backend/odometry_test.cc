@@ -22,6 +22,7 @@
 #include "core/config_io.h"
 #include "core/evaluation.h"
 #include "experiments/synthetic/synthetic_sequence.h"
+#include "core/statistics.h"
 #include "tests/backend/rendered_sequence.h"
 
 namespace pldvo {
@@ -246,9 +247,7 @@ TEST(OdometryTest, CompareSolverSolvesTheSameProblemsWithoutChangingTheRun) {
     compared.push_back({frame.timestamp, frame.world_from_cam_compared});
   }
   ASSERT_EQ(translation_diff.size(), static_cast<size_t>(kFrames - 1));
-  std::nth_element(translation_diff.begin(), translation_diff.begin() + translation_diff.size() / 2,
-                   translation_diff.end());
-  EXPECT_LT(translation_diff[translation_diff.size() / 2], 1e-4);
+  EXPECT_LT(Median(translation_diff), 1e-4);
   const Trajectory& gt = Sequence().sequence.ground_truth;
   const double rpe_run = EvaluateTrajectory(gt, run.estimate).rpe_cm_s;
   const double rpe_compared = EvaluateTrajectory(gt, compared).rpe_cm_s;

@@ -16,6 +16,7 @@
 #include "backend/odometry/mapping_worker.h"
 #include "core/image_pyramid.h"
 #include "core/pinhole_camera.h"
+#include "core/statistics.h"
 #include "frontend/line_frontend.h"
 #include "residuals/covariance_models.h"
 #include "tests/backend/rendered_sequence.h"
@@ -169,14 +170,10 @@ TEST(ReferenceBuilderTest, FootPointsReprojectOntoTheMatchedLinesAtTheTruePose) 
     traced.push_back(std::abs(l.dot(at_pixel.homogeneous())));
   }
   ASSERT_GT(foot.size(), 500u);
-  const auto median = [](std::vector<double> v) {
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    return v[v.size() / 2];
-  };
   std::printf("edge pixels %zu: median |l^T x'| foot points %.3f px, traced pixels %.3f px\n",
-              foot.size(), median(foot), median(traced));
-  EXPECT_LT(median(foot), 0.25);
-  EXPECT_GT(median(traced), 0.4);
+              foot.size(), Median(foot), Median(traced));
+  EXPECT_LT(Median(foot), 0.25);
+  EXPECT_GT(Median(traced), 0.4);
 }
 
 // Mapping jobs on one textured image: a keyframe (new, or a switch new_from_old) and a frame

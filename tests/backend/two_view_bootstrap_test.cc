@@ -14,6 +14,7 @@
 #include "core/dataset.h"
 #include "core/evaluation.h"
 #include "experiments/synthetic/synthetic_sequence.h"
+#include "core/statistics.h"
 #include "tests/render_cache.h"
 #include "tests/small_lowtex_options.h"
 

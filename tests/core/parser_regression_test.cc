@@ -69,8 +69,9 @@ class ParserRegressionTest : public ::testing::Test {
 constexpr char kCameraKeys[] =
     "model: pinhole\nwidth: 64\nheight: 48\nfx: 50\nfy: 50\ncx: 31.5\ncy: 23.5\ndistortion: []\n";
 
-// cv::FileStorage (OpenCV 4.6) loops forever on these: a second YAML document starting with
-// '-'. Before the guard in OpenYamlForReading each of them hung the reader.
+// cv::FileStorage (OpenCV 4.6) looped forever on these: a second YAML document starting with
+// '-'. yaml-cpp would read the first document and drop the rest without a word; the
+// one-document rule of core/yaml_reader.cc rejects them with the line.
 TEST_F(ParserRegressionTest, YamlInputsThatHangOpenCvAreRejected) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"%YAML:1.0\n---L:1\n--x-\n\n", "after '---'"},  // the fuzzer's input, minimised
@@ -97,13 +98,25 @@ TEST_F(ParserRegressionTest, YamlSpellingsNextToTheGuardStillRead) {
   }
 }
 
+// OpenCV's reader took "4294967936" for the int 640 (strtol, then a cast), and rejected a
+// comment line before "---"; the yaml-cpp reader does neither.
+TEST_F(ParserRegressionTest, YamlIntegersOutOfRangeAndCommentsBeforeTheMarker) {
+  std::string text = kCameraKeys;
+  text.replace(text.find("width: 64"), 9, "width: 4294967936");
+  const std::string path = Write("camera.yaml", text);
+  EXPECT_THAT(ErrorOf([&] { ReadCameraYaml(path); }), HasSubstr(path + ":2: key 'width'"));
+  const std::string commented = Write("commented.yaml", std::string("# c\n---\n") + kCameraKeys);
+  EXPECT_EQ(ErrorOf([&] { ReadCameraYaml(commented); }), "");
+}
+
 // An empty key in a nested map made cv::FileStorage throw std::length_error
-// ("basic_string::_M_create"), which escaped without the file name (config_fuzzer).
+// ("basic_string::_M_create"), which escaped without the file name (config_fuzzer). yaml-cpp
+// reads it as a null key, which core/yaml_reader.cc rejects with the line.
 TEST_F(ParserRegressionTest, EmptyNestedKeyIsAYamlErrorNamingTheFile) {
   const std::string path = Write("config.yaml", "%YAML:1.0\n---\nname:\n   ...x: 1\n   :\n");
   StringOptions options;
   const std::string error = ErrorOf([&] { LoadConfigYaml(path, &options); });
-  EXPECT_THAT(error, HasSubstr(path + ": YAML syntax error"));
+  EXPECT_THAT(error, HasSubstr(path + ":5: YAML syntax error"));
 }
 
 // WriteCameraYaml spelled cx = 19444444444444444.2 as "19444444444444444", which

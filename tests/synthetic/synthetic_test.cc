@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "experiments/synthetic/synthetic_sequence.h"
+#include "core/statistics.h"
 
 namespace pldvo::synthetic {
 namespace {
@@ -32,13 +33,6 @@ SynthOptions SmallOptions(const std::string& preset, int width = 320, int height
   options.fx = options.fy = 525.0 * width / 640.0;  // the 640x480 field of view
   options.threads = 2;
   return options;
-}
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
-  const auto mid = values.begin() + values.size() / 2;
-  std::nth_element(values.begin(), mid, values.end());
-  return *mid;
 }
 
 float Bilinear(const cv::Mat& image, double x, double y) {
