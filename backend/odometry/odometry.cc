@@ -178,6 +178,11 @@ OdometryFrameResult Odometry::Finalize(OdometryFrameResult result) {
   const bool tracked = IsTracked(result.status);
   if (tracked) {
     ++stats_.tracked;
+    // The first frame tracked on a fresh random map starts a new scale segment.
+    if (scale_lost_) {
+      ++stats_.scale_segments;
+      scale_lost_ = false;
+    }
   } else {
     ++stats_.lost_frames;
     // A lost event starts at the first non-tracked frame after a tracked one.
@@ -329,12 +334,23 @@ void Odometry::NotifyRetired(const KeyframeMap& map) {
   retiring_ = ActiveKeyframe();
 }
 
+void Odometry::NoteKeyframeMap(const KeyframeMap& map) {
+  if (map.keyframe_id <= last_noted_keyframe_id_) return;
+  last_noted_keyframe_id_ = map.keyframe_id;
+  // Only a re-initialisation sets random_init on a later keyframe (MappingWorker: kNewKeyframe
+  // with min_propagated_points); the map then has an arbitrary scale of its own.
+  if (map.keyframe_id != first_keyframe_id_ && map.random_init) scale_lost_ = true;
+}
+
 void Odometry::RefreshMap(OdometryTiming* timing) {
   if (map_ == nullptr || map_->keyframe_id != keyframe_.id) {
     const auto start = WallClock::now();
     map_ = mapper_->WaitForKeyframe(keyframe_.id);
     timing->wait_ms += MsSince(start);
-    if (map_ != nullptr) NotifyRetired(*map_);
+    if (map_ != nullptr) {
+      NotifyRetired(*map_);
+      NoteKeyframeMap(*map_);
+    }
   } else {
     map_ = mapper_->Latest();
   }
@@ -432,6 +448,8 @@ void Odometry::StartFirstKeyframe(int index, double timestamp, const cv::Mat& im
   StartKeyframe(index, timestamp, image, std::move(lines), SE3(), true, SE3(), 0, &result->timing,
                 nullptr, depth);
   initialized_ = true;
+  first_keyframe_id_ = keyframe_.id;
+  stats_.scale_segments = 1;
   world_from_last_good_ = SE3();
   last_good_index_ = index;
   velocity_ = SE3();

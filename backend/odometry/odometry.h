@@ -55,6 +55,11 @@ struct OdometryStatistics {
   int lost_frames = 0;  // lost, reinitialized or failed
   int lost_events = 0;  // maximal runs of consecutive non-tracked frames
   int reinitializations = 0;
+  // Pieces of the trajectory with one consistent scale: 1 from the first keyframe, plus one per
+  // re-initialisation whose keyframe got a fresh random map (fewer than
+  // odometry.reinit_min_points hypotheses survived the propagation), counted at the first frame
+  // tracked after it. A re-initialisation that keeps the propagated map stays in the segment.
+  int scale_segments = 0;
   int dropped_mapping_updates = 0;
   int failed_mapping_jobs = 0;
   int edge_ba_windows = 0;  // edge BA windows solved
@@ -180,6 +185,9 @@ class Odometry {
   // that the current keyframe observes (counts a failed covariance instead).
   void SendLineDepths(const EdgeBAResult& result);
   void NotifyRetired(const KeyframeMap& map);
+  // A new keyframe's first published map: a fresh random map on a re-initialisation keyframe
+  // loses the scale (scale_lost_).
+  void NoteKeyframeMap(const KeyframeMap& map);
   OdometryFrameResult Finalize(OdometryFrameResult result);
 
   PinholeCamera camera_;
@@ -217,6 +225,11 @@ class Odometry {
   bool recovering_ = false;   // a frame was lost since the last tracked one
   bool last_tracked_ = true;  // the previous frame was tracked (lost-event counting)
   int last_index_ = -1;
+  // Scale segments: the first keyframe's id, the newest keyframe whose map was looked at, and
+  // whether a fresh random map replaced the scale since the last tracked frame.
+  int first_keyframe_id_ = -1;
+  int last_noted_keyframe_id_ = -1;
+  bool scale_lost_ = false;
   OdometryStatistics stats_;
 };
 

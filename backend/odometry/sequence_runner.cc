@@ -414,6 +414,9 @@ SequenceRunResult SequenceRunner::Run() {
   summary["lost_frames"] = stats.lost_frames;
   summary["failed_frames"] = failed;
   summary["reinitializations"] = stats.reinitializations;
+  // Pieces of the trajectory with one scale: a re-initialisation with a fresh random map starts
+  // a new one (OdometryStatistics::scale_segments).
+  summary["scale_segments"] = stats.scale_segments;
   summary["dropped_mapping_updates"] = stats.dropped_mapping_updates;
   summary["failed_mapping_jobs"] = stats.failed_mapping_jobs;
   summary["parallel_mapping"] = config_.odometry.parallel_mapping;

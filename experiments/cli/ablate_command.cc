@@ -1,12 +1,14 @@
 // `pldvo ablate --configs A.yaml,B.yaml --datasets DIR1,DIR2 --out OUT [--jobs N] [--shard i/N]
-//              [--repeats R] [--set key=value]...`: `pldvo run` for every (dataset, config)
-// pair, each in its own subprocess of this binary (a crash or hang of one run cannot take the
-// others down), N at a time. With --repeats R every pair runs R times, repeat k with
-// mapping.init_seed = k (the monocular random initial map; docs/odometry.md). Run k (dataset,
+//              [--repeats R] [--run_max_frames N] [--set key=value]...`: `pldvo run` for every
+// (dataset, config) pair, each in its own subprocess of this binary (a crash or hang of one run
+// cannot take the others down), N at a time. With --repeats R every pair runs R times, repeat k
+// with mapping.init_seed = k (the monocular random initial map; docs/odometry.md). Run k (dataset,
 // config, repeat order) belongs to shard k mod N. Per run: OUT/runs/<dataset>__<config>/ (with
 // R > 1: .../<dataset>__<config>__seed<k>/) holds the run's outputs and log.txt. Then, over the
 // whole grid (runs of other shards count when their summary.json exists in OUT):
-//   OUT/results.csv                  one row per run (status, counts, RPE, ATE, timing);
+//   OUT/results.csv                  one row per run (status, counts, RPE, ATE, timing, scale
+//                                    segments; new columns are appended, scripts/targets.sh
+//                                    reads them by position);
 //   OUT/results.md                   RPE tables like the paper's Tables I/II (X: failed run;
 //                                    with R > 1 the median and [min, max] over the repeats);
 //   OUT/trajectories_<dataset>.svg   top view, Sim(3)-aligned estimates (repeat 1) against
@@ -50,6 +52,8 @@ DEFINE_string(datasets, "", "Comma-separated dataset folders (one row each).");
 DEFINE_int32(jobs, 1, "Runs in parallel (each a subprocess).");
 DEFINE_string(shard, "0/1", "i/N: run only the pairs k with k mod N == i.");
 DEFINE_bool(skip_existing, false, "Do not rerun pairs whose summary.json exists.");
+DEFINE_int32(run_max_frames, 0,
+             "Passed to every run as --max_frames: only the first N frames (0 = all).");
 DEFINE_int32(repeats, 1,
              "Runs per pair; repeat k sets mapping.init_seed=k. Tables: median [min, max].");
 
@@ -235,6 +239,9 @@ int RunAblate(const CommandContext& context) {
       if (!gflags::GetCommandLineFlagInfoOrDie("format").is_default) {
         args.insert(args.end(), {"--format", FLAGS_format});
       }
+      if (FLAGS_run_max_frames > 0) {
+        args.insert(args.end(), {"--max_frames", std::to_string(FLAGS_run_max_frames)});
+      }
       for (const std::string& set : context.config_overrides) {
         args.insert(args.end(), {"--set", set});
       }
@@ -279,7 +286,8 @@ int RunAblate(const CommandContext& context) {
   {
     std::ofstream csv(out + "/results.csv");
     csv << "dataset,config,status,frames,tracked,keyframes,lost_events,rpe_cm_s,rpe_deg_s,ate_m,"
-           "coverage,scale_drift,ms_median_tracking_thread,ms_median_total,init_seed,dir\n";
+           "coverage,scale_drift,ms_median_tracking_thread,ms_median_total,init_seed,dir,"
+           "scale_segments\n";
     for (const Pair& pair : pairs) {
       const nlohmann::json& s = summaries[pair.index];
       auto integer = [&](const char* key) {
@@ -296,7 +304,7 @@ int RunAblate(const CommandContext& context) {
           << "," << Fixed(JsonNumber(s, "scale_drift"), 3) << ","
           << Fixed(JsonNumber(ms, "tracking_thread"), 2) << "," << Fixed(JsonNumber(ms, "total"), 2)
           << "," << (repeats > 1 ? std::to_string(pair.repeat) : std::string()) << "," << pair.dir
-          << "\n";
+          << "," << integer("scale_segments") << "\n";
     }
   }
   {
@@ -366,6 +374,8 @@ int RunAblate(const CommandContext& context) {
     table("RPE rotation (deg/s)", "rpe_deg_s", 3);
     table("ATE (m)", "ate_m", 4);
     table("Scale drift (max / min of the estimate's scale over 1 s windows)", "scale_drift", 2);
+    table("Scale segments (a re-initialisation with a fresh random map starts one)",
+          "scale_segments", 0);
     // With odometry.parallel_mapping false the tracking thread also runs every mapping job.
     const bool inline_mapping = std::any_of(summaries.begin(), summaries.end(), [](const auto& s) {
       return s.is_object() && s.contains("parallel_mapping") && s["parallel_mapping"] == false;

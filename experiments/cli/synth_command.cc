@@ -16,7 +16,8 @@
 #include "experiments/synthetic/synthetic_sequence.h"
 
 DEFINE_string(preset, "lowtex",
-              "Scene appearance and motion: textured | lowtex | lighting | fast.");
+              "Scene appearance and motion: textured | lowtex | lighting | fast | autoexposure | "
+              "checkerboard | boxes | handheld (docs/synthetic.md).");
 DEFINE_int32(frames, 300, "Number of frames (30 fps).");
 DEFINE_int32(seed, 1, "Seed of the scene layout, trajectory and noise.");
 DEFINE_int32(width, 640, "Image width in pixels.");

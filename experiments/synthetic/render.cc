@@ -9,8 +9,9 @@
 // carried onto the surface by ray differentials (PixelFootprint).
 // Pass 1 casts one ray through each pixel centre and records the surface (primitive, face) and
 // z-depth; pass 2 re-renders pixels whose 8-neighbourhood holds another surface with n x n
-// sub-pixel rays (anti-aliasing). Each 16x16 tile only tests the boxes that meet the tile's
-// frustum, and each supersampled pixel only those of the tile that meet the pixel's frustum.
+// sub-pixel rays (anti-aliasing); a checkerboard's squares count as surfaces. Each 16x16 tile only
+// tests the boxes that meet the tile's frustum, and each supersampled pixel only those of the tile
+// that meet the pixel's frustum.
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -104,7 +105,10 @@ class Renderer {
                                      static_cast<int>(candidates.size()), &hit)) {
             radiance[i] = static_cast<float>(shade(hit, direction));
             depth[i] = static_cast<float>(hit.t);  // the ray has z = 1 in the camera frame
-            surface[i] = hit.primitive * 6 + hit.face;
+            // A checkerboard's squares count as surfaces of their own, so that their
+            // boundaries are anti-aliased like object edges.
+            surface[i] = (hit.primitive * 6 + hit.face) * 2 +
+                         scene_.CheckerParity(hit, origin + hit.t * direction);
           } else {
             radiance[i] = 0.0f;
             depth[i] = 0.0f;

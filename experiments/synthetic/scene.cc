@@ -277,6 +277,30 @@ void FurnishWalls(SceneBuilder* b, const double wall_albedo[4]) {
 
 double Frac(double x) { return x - std::floor(x); }
 
+// Plain boxes standing on the floor in front of the walls, count / 4 per wall in equal stretches
+// of it, 0.7-1.0 m between the wall and the box's back, 0.2-0.35 m deep (front faces at most
+// 1.35 m from the wall, in front of the furniture, which reaches 0.65 m): their vertical outlines
+// are depth discontinuities against the wall or the furniture behind.
+void AddOccluderBoxes(SceneBuilder* b, int count, const double wall_albedo[4]) {
+  Rng& rng = b->rng();
+  const Eigen::Vector3d& room = b->scene().room_size();
+  const int per_wall = (count + 3) / 4;
+  for (int i = 0; i < count; ++i) {
+    const int wall = i % 4, slot = i / 4;
+    const WallFrame frame = MakeWallFrame(wall, room);
+    const double stretch = (frame.length - 1.0) / per_wall;  // 0.5 m kept free at each corner
+    // Several draws feeding one call are made first, last argument first (core/random_draws.h).
+    const double albedo = b->AlbedoAwayFrom(wall_albedo[wall], 0.15, 0.9, 0.15);
+    const double height = rng.Uniform(0.5, 1.6);
+    const double depth = rng.Uniform(0.2, 0.35);
+    const double gap = rng.Uniform(0.7, 1.0);
+    const double width = std::min(rng.Uniform(0.4, 0.9), 0.9 * stretch);
+    const double s0 = 0.5 + slot * stretch + rng.Uniform(0.0, stretch - width);
+    b->WallBox(wall, s0, s0 + width, gap, gap + depth, 0.0, height, albedo, Pattern::kPlain, 0.1,
+               "occluder");
+  }
+}
+
 }  // namespace
 
 void Scene::SetRoom(const Eigen::Vector3d& room_size) {
@@ -333,7 +357,7 @@ void Scene::AddPrimitive(const Primitive& primitive) {
   }
 }
 
-Scene Scene::Generate(uint64_t seed) {
+Scene Scene::Generate(uint64_t seed, const SceneStyle& style) {
   Scene scene;
   Rng rng(seed * 0x2545F4914F6CDD1Dull + 17);
   // Several draws feeding one call are made first, last argument first (core/random_draws.h).
@@ -376,6 +400,20 @@ Scene Scene::Generate(uint64_t seed) {
   SceneBuilder builder(&scene, &rng);
   FurnishWalls(&builder, wall_albedo);
   AddTable(&builder, floor_albedo);
+  if (style.checker_size > 0.0) {
+    // Black and white squares on the walls and the floor, aligned with the room's corner.
+    Primitive& room_interior = scene.primitives_[0];
+    for (int f = 0; f < 5; ++f) {
+      room_interior.albedo[f] = 0.85;
+      room_interior.pattern[f] = Pattern::kChecker;
+    }
+    room_interior.texture_scale = style.checker_size;
+  }
+  if (style.occluder_boxes > 0) {
+    Rng occluder_rng(seed * 0x9E3779B97F4A7C15ull + 29);
+    SceneBuilder occluders(&scene, &occluder_rng);
+    AddOccluderBoxes(&occluders, style.occluder_boxes, wall_albedo);
+  }
   return scene;
 }
 
@@ -532,6 +570,17 @@ double BandCoverage(double r, double period, double width, double sigma) {
 
 }  // namespace
 
+int Scene::CheckerParity(const Hit& hit, const Eigen::Vector3d& point_in_world) const {
+  const Primitive& p = primitives_[hit.primitive];
+  if (p.pattern[hit.face] != Pattern::kChecker) return 0;
+  const int axis = hit.face / 2;
+  const Eigen::Vector3d q =
+      p.box_from_world_rotation * (point_in_world - p.center_in_world) + p.half_size;
+  const int64_t iu = static_cast<int64_t>(std::floor(q[(axis + 1) % 3] / p.texture_scale));
+  const int64_t iv = static_cast<int64_t>(std::floor(q[(axis + 2) % 3] / p.texture_scale));
+  return static_cast<int>((iu + iv) & 1);
+}
+
 PixelFootprint PixelFootprint::OnPlane(const Eigen::Vector3d& normal,
                                        const Eigen::Vector3d& direction, double t,
                                        const Eigen::Vector3d& ray_per_x,
@@ -567,13 +616,16 @@ double Scene::Albedo(const Hit& hit, const Eigen::Vector3d& point_in_world, doub
   }
   double factor = 1.0;
   const uint32_t seed = p.texture_seed + 7919u * static_cast<uint32_t>(hit.face);
-  if (texture_contrast > 0.0) {
+  if (p.pattern[hit.face] == Pattern::kChecker) {
+    if (CheckerParity(hit, point_in_world) == 1) factor = kCheckerDark;
+  } else if (texture_contrast > 0.0) {
     const double s = p.texture_scale;
     // Texture cells (of size s) crossed per pixel along x and y.
     const double cells_x = uv_per_x.norm() / s, cells_y = uv_per_y.norm() / s;
     double w = 0.5;
     switch (p.pattern[hit.face]) {
       case Pattern::kPlain:
+      case Pattern::kChecker:  // handled above
         w = 0.5;
         break;
       case Pattern::kNoise:

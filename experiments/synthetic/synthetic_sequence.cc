@@ -83,9 +83,20 @@ CameraPath DrawPath(const Scene& scene, const SynthOptions& options, double ampl
   const double base_pitch = rng->Uniform(-0.4, -0.15);
   const double base_yaw = rng->Uniform(0.0, 2.0 * M_PI);
   path.angle_offset = Eigen::Vector3d(base_yaw, base_pitch, 0.0);
-  const double angle_budget[3] = {rng->Uniform(0.6, 1.3), 0.2, 0.07};  // radians
+  const double angle_budget[3] = {rng->Uniform(0.6, 1.3), options.pitch_amplitude,
+                                  options.roll_amplitude};  // radians
   for (int a = 0; a < 3; ++a) {
     DrawTerms(rng, angle_budget[a], path.angle_amp[a], path.angle_freq[a], path.angle_phase[a]);
+  }
+  if (options.jitter_deg > 0.0) {
+    // Physiological hand tremor sits at 4-12 Hz; one sinusoid per angle.
+    for (int a = 0; a < 3; ++a) {
+      const double phase = rng->Uniform(0.0, 2.0 * M_PI);
+      const double hz = rng->Uniform(4.0, 10.0);
+      path.jitter_amp[a] = options.jitter_deg * M_PI / 180.0;
+      path.jitter_freq[a] = 2.0 * M_PI * hz;
+      path.jitter_phase[a] = phase;
+    }
   }
   // Time scaling: mean speed and rotation rate over the sequence equal the options'.
   const double duration = std::max(options.frames - 1, 1) / options.fps;
@@ -201,11 +212,21 @@ void WriteOrThrow(const std::string& path, const cv::Mat& image) {
   if (!cv::imwrite(path, image)) throw std::runtime_error("WriteSequence: cannot write " + path);
 }
 
+bool IsPreset(const std::string& name) {
+  for (const char* preset : {"textured", "lowtex", "lighting", "fast", "autoexposure",
+                             "checkerboard", "boxes", "handheld"}) {
+    if (name == preset) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 std::string SynthOptions::Check() const {
-  if (preset != "textured" && preset != "lowtex" && preset != "lighting" && preset != "fast") {
-    return "preset: '" + preset + "' is not one of textured | lowtex | lighting | fast";
+  if (!IsPreset(preset)) {
+    return "preset: '" + preset +
+           "' is not one of textured | lowtex | lighting | fast | autoexposure | checkerboard | "
+           "boxes | handheld";
   }
   if (frames < 1) return "frames: must be >= 1";
   if (seed < 0) return "seed: must be >= 0";
@@ -225,6 +246,15 @@ std::string SynthOptions::Check() const {
     return "vignetting_strength: must be in [0, 1]";
   }
   if (!(lighting_period > 0.0)) return "lighting_period: must be > 0";
+  if (!(contrast >= 0.0 && contrast <= 10.0)) return "contrast: must be in [0, 10]";
+  if (!(brightness >= -1.0 && brightness <= 1.0)) return "brightness: must be in [-1, 1]";
+  if (!(auto_exposure_amplitude < 1.0)) return "auto_exposure_amplitude: must be < 1";
+  if (!(auto_exposure_period > 0.0)) return "auto_exposure_period: must be > 0";
+  if (occluder_boxes > 40) return "occluder_boxes: must be <= 40";
+  if (!(pitch_amplitude < 1.0) || !(roll_amplitude < 1.0)) {
+    return "pitch_amplitude, roll_amplitude: must be < 1 rad";
+  }
+  if (!(jitter_deg < 5.0)) return "jitter_deg: must be < 5";
   if (!(ambient >= 0.0) || !(light_intensity >= 0.0)) {
     return "ambient, light_intensity: must be >= 0";
   }
@@ -243,8 +273,20 @@ SynthOptions ResolvePreset(const SynthOptions& options) {
   const bool fast = options.preset == "fast";
   const bool textured = options.preset == "textured";
   const bool lighting = options.preset == "lighting";
-  if (resolved.speed < 0.0) resolved.speed = fast ? 0.75 : 0.25;
-  if (resolved.angular_speed < 0.0) resolved.angular_speed = fast ? 45.0 : 15.0;
+  const bool handheld = options.preset == "handheld";
+  // Handheld: TUM fr1/rpy-like rotation about all three axes with little translation.
+  if (resolved.speed < 0.0) resolved.speed = fast ? 0.75 : handheld ? 0.15 : 0.25;
+  if (resolved.angular_speed < 0.0) resolved.angular_speed = fast ? 45.0 : handheld ? 40.0 : 15.0;
+  if (resolved.pitch_amplitude < 0.0) resolved.pitch_amplitude = handheld ? 0.35 : 0.2;
+  if (resolved.roll_amplitude < 0.0) resolved.roll_amplitude = handheld ? 0.3 : 0.07;
+  if (resolved.jitter_deg < 0.0) resolved.jitter_deg = handheld ? 0.15 : 0.0;
+  if (resolved.auto_exposure_amplitude < 0.0) {
+    resolved.auto_exposure_amplitude = options.preset == "autoexposure" ? 0.3 : 0.0;
+  }
+  if (resolved.checker_size < 0.0) {
+    resolved.checker_size = options.preset == "checkerboard" ? 0.08 : 0.0;
+  }
+  if (resolved.occluder_boxes < 0) resolved.occluder_boxes = options.preset == "boxes" ? 16 : 0;
   if (resolved.texture_contrast < 0.0) resolved.texture_contrast = textured ? 0.3 : 0.0;
   if (resolved.gain_amplitude < 0.0) resolved.gain_amplitude = lighting ? 0.25 : 0.0;
   if (resolved.bias_amplitude < 0.0) resolved.bias_amplitude = lighting ? 15.0 : 0.0;
@@ -264,6 +306,8 @@ Eigen::Vector3d CameraPath::Angles(double time) const {
   Eigen::Vector3d angles = angle_offset;
   for (int a = 0; a < 3; ++a) {
     angles[a] += SumOfSines(angle_amp[a], angle_freq[a], angle_phase[a], time);
+    if (jitter_amp[a] != 0.0)
+      angles[a] += jitter_amp[a] * std::sin(jitter_freq[a] * time + jitter_phase[a]);
   }
   return angles;
 }
@@ -298,6 +342,24 @@ Lighting LightingAt(const SyntheticSequence& sequence, double time) {
       sequence.scene.light_in_world() +
       options.light_motion *
           Eigen::Vector3d(std::cos(w * time + light_phase), std::sin(w * time + light_phase), 0.0);
+  // The camera's side: auto-exposure a(t) scales the exposure (so the scene's gain and bias),
+  // then I -> contrast (I - 127.5) + 127.5 + 255 brightness. Folded into one affine map, so the
+  // noise is added after it (in gray levels) and the 8-bit rounding clips the result.
+  if (options.auto_exposure_amplitude > 0.0) {
+    // A smooth random walk of the gain: random knots every auto_exposure_period seconds,
+    // smoothstep between them (value noise along time).
+    const uint32_t ae_seed = static_cast<uint32_t>(internal::Mix64(options.seed + 0xAE0ull));
+    const double noise = internal::ValueNoise(time / options.auto_exposure_period, 0.0, ae_seed);
+    const double exposure_gain = 1.0 + options.auto_exposure_amplitude * (2.0 * noise - 1.0);
+    lighting.gain *= exposure_gain;
+    lighting.bias *= exposure_gain;
+  }
+  if (options.contrast != 1.0 || options.brightness != 0.0) {
+    constexpr double kMidGray = 127.5;
+    lighting.gain *= options.contrast;
+    lighting.bias =
+        options.contrast * (lighting.bias - kMidGray) + kMidGray + 255.0 * options.brightness;
+  }
   return lighting;
 }
 
@@ -311,7 +373,10 @@ SyntheticSequence MakeSequence(const SynthOptions& options) {
   sequence.camera.fy = resolved.fy;
   sequence.camera.cx = resolved.cx;
   sequence.camera.cy = resolved.cy;
-  sequence.scene = Scene::Generate(static_cast<uint64_t>(resolved.seed));
+  SceneStyle style;
+  style.checker_size = resolved.checker_size;
+  style.occluder_boxes = resolved.occluder_boxes;
+  sequence.scene = Scene::Generate(static_cast<uint64_t>(resolved.seed), style);
 
   Rng rng(static_cast<uint64_t>(resolved.seed) * 0xD1342543DE82EF95ull + 101);
   constexpr int kAttempts = 60;

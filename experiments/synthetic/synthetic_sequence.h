@@ -28,7 +28,9 @@ namespace pldvo::synthetic {
 // Every parameter of a sequence. Fields documented "< 0: preset" take their value from the
 // preset unless set; ResolvePreset() fills them in (MakeSequence calls it).
 struct SynthOptions {
-  std::string preset = "lowtex";  // textured | lowtex | lighting | fast
+  // textured | lowtex | lighting | fast, and the failure families of the line term (all on
+  // lowtex's albedo): autoexposure | checkerboard | boxes | handheld (docs/synthetic.md).
+  std::string preset = "lowtex";
   int frames = 300;
   int seed = 1;  // scene layout, trajectory and noise; any value >= 0
   int width = 640;
@@ -54,15 +56,28 @@ struct SynthOptions {
   double bias_amplitude = -1.0;      // global bias swing in gray levels; < 0: preset (lighting 15)
   double light_motion = -1.0;        // radius in m of the moving light's circle; < 0: preset
   double lighting_period = 8.0;      // seconds per cycle of gain, bias and light motion
-  double ambient = 0.35;             // ambient term of the shading (albedo 1 -> 255 * ambient)
-  double light_intensity = 0.75;     // point-light term at normal incidence, 2.5 m away
-  double min_depth = 0.5;            // metres: every pixel of every frame sees at least this far
-  double clearance = 0.35;           // metres from the camera centre to any surface
-  int threads = 0;                   // render threads; 0 = hardware concurrency
+  // Camera-side photometry, applied to the image before the noise (docs/synthetic.md):
+  // I = contrast (a(t) I_scene - 127.5) + 127.5 + 255 brightness, a(t) the auto-exposure gain.
+  double contrast = 1.0;                  // scale of the deviation from mid-gray
+  double brightness = 0.0;                // offset as a fraction of 255
+  double auto_exposure_amplitude = -1.0;  // a(t) in 1 +- this; < 0: preset (autoexposure 0.3)
+  double auto_exposure_period = 2.0;      // seconds between the gain's random knots
+  double checker_size = -1.0;     // m; walls and floor black/white squares; < 0: preset (0.08)
+  int occluder_boxes = -1;        // plain boxes 0.7-1.35 m before the walls; < 0: preset (boxes 16)
+  double pitch_amplitude = -1.0;  // rad, pitch swing of the path; < 0: preset (0.2, handheld 0.35)
+  double roll_amplitude = -1.0;   // rad, roll swing of the path; < 0: preset (0.07, handheld 0.3)
+  double jitter_deg = -1.0;       // hand tremor per axis, 4-10 Hz; < 0: preset (handheld 0.15)
+  double ambient = 0.35;          // ambient term of the shading (albedo 1 -> 255 * ambient)
+  double light_intensity = 0.75;  // point-light term at normal incidence, 2.5 m away
+  double min_depth = 0.5;         // metres: every pixel of every frame sees at least this far
+  double clearance = 0.35;        // metres from the camera centre to any surface
+  int threads = 0;                // render threads; 0 = hardware concurrency
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
-    v.Field("preset", &preset, "Scene appearance and motion: textured | lowtex | lighting | fast.");
+    v.Field("preset", &preset,
+            "Scene appearance and motion: textured | lowtex | lighting | fast | autoexposure | "
+            "checkerboard | boxes | handheld.");
     v.Field("frames", &frames, "Number of frames (30 fps).");
     v.Field("seed", &seed, "Seed of the scene layout, trajectory and noise (>= 0).");
     v.Field("width", &width, "Image width in pixels.");
@@ -99,6 +114,29 @@ struct SynthOptions {
             "Radius in m of the point light's circular motion; < 0: preset (lighting 1, else 0).");
     v.Field("lighting_period", &lighting_period,
             "Seconds per cycle of the gain, bias and light motion.");
+    v.Field("contrast", &contrast,
+            "Image contrast around mid-gray: I = c (I - 127.5) + 127.5, before the noise.");
+    v.Field("brightness", &brightness,
+            "Image brightness offset as a fraction of 255 (0.2 = +51 gray levels), before the "
+            "noise.");
+    v.Field("auto_exposure_amplitude", &auto_exposure_amplitude,
+            "Auto-exposure: a smooth random global gain in 1 +- this; < 0: preset "
+            "(autoexposure 0.3, else 0).");
+    v.Field("auto_exposure_period", &auto_exposure_period,
+            "Seconds between the auto-exposure gain's random knots (smoothstep in between).");
+    v.Field("checker_size", &checker_size,
+            "Square size in m of a black/white checkerboard on the walls and floor; 0 = none; "
+            "< 0: preset (checkerboard 0.08, else 0).");
+    v.Field("occluder_boxes", &occluder_boxes,
+            "Plain boxes standing 0.7-1.35 m in front of the walls (occlusion edges); < 0: preset "
+            "(boxes 16, else 0).");
+    v.Field("pitch_amplitude", &pitch_amplitude,
+            "Pitch swing of the camera path in rad; < 0: preset (0.2, handheld 0.35).");
+    v.Field("roll_amplitude", &roll_amplitude,
+            "Roll swing of the camera path in rad; < 0: preset (0.07, handheld 0.3).");
+    v.Field("jitter_deg", &jitter_deg,
+            "Hand tremor: per-axis rotation jitter amplitude in degrees at 4-10 Hz; < 0: preset "
+            "(handheld 0.15, else 0).");
     v.Field("ambient", &ambient, "Ambient shading term.");
     v.Field("light_intensity", &light_intensity,
             "Point-light shading term at normal incidence and 2.5 m distance.");
@@ -128,7 +166,9 @@ struct RenderedFrame {
 // box frame, where it spans [-half_size, half_size].
 struct Primitive {
   enum class Kind { kRoom, kBox };
-  enum class Pattern { kPlain, kNoise, kWood, kTiles };
+  // kChecker: squares of texture_scale in the face's coordinates, albedo or kCheckerDark x albedo
+  // (independent of texture_contrast).
+  enum class Pattern { kPlain, kNoise, kWood, kTiles, kChecker };
   Kind kind = Kind::kBox;
   Eigen::Matrix3d box_from_world_rotation = Eigen::Matrix3d::Identity();
   Eigen::Vector3d center_in_world = Eigen::Vector3d::Zero();
@@ -158,11 +198,21 @@ struct PixelFootprint {
                                 const Eigen::Vector3d& ray_per_y, double sigma_px);
 };
 
+// Scene additions of the failure families; the defaults give the plain random room.
+struct SceneStyle {
+  double checker_size = 0.0;  // > 0: walls and floor are checkerboards of this square size (m)
+  int occluder_boxes = 0;     // plain boxes standing 0.7-1.35 m in front of the walls
+};
+
 class Scene {
  public:
+  // Dark squares of a checkerboard: this fraction of the face's albedo.
+  static constexpr double kCheckerDark = 0.1;
+
   Scene() = default;
-  // A random room layout drawn from the seed.
-  static Scene Generate(uint64_t seed);
+  // A random room layout drawn from the seed. The style's additions are drawn from their own
+  // generator, so the room, its furniture and the light are those of the plain style.
+  static Scene Generate(uint64_t seed, const SceneStyle& style = SceneStyle());
 
   const std::vector<Primitive>& primitives() const { return primitives_; }
   // The scene's 3D edge segments: the room's 12 edges and the edges of every box (box-on-wall
@@ -194,6 +244,9 @@ class Scene {
   // "Texture filtering"): sinusoidal bands exactly, value noise and grout approximately.
   double Albedo(const Hit& hit, const Eigen::Vector3d& point_in_world, double texture_contrast,
                 double albedo_variation, const PixelFootprint& footprint) const;
+  // 1 on the dark squares of a checkerboard face, else 0 (the renderer anti-aliases the
+  // squares' boundaries like surface boundaries).
+  int CheckerParity(const Hit& hit, const Eigen::Vector3d& point_in_world) const;
   // Distance from a point to the nearest surface (room walls and boxes).
   double DistanceToSurfaces(const Eigen::Vector3d& point_in_world) const;
 
@@ -218,8 +271,10 @@ struct CameraPath {
   Eigen::Vector3d angle_offset = Eigen::Vector3d::Zero();  // yaw, pitch, roll in radians
   double amp[3][kTerms] = {}, freq[3][kTerms] = {}, phase[3][kTerms] = {};
   double angle_amp[3][kTerms] = {}, angle_freq[3][kTerms] = {}, angle_phase[3][kTerms] = {};
+  // Hand tremor: one fast sinusoid per angle (rad, rad/s), not rescaled with the motion.
+  double jitter_amp[3] = {}, jitter_freq[3] = {}, jitter_phase[3] = {};
   Eigen::Vector3d PositionInWorld(double time) const;
-  // yaw, pitch, roll.
+  // yaw, pitch, roll (tremor included).
   Eigen::Vector3d Angles(double time) const;
   // Camera looking along (cos p cos y, cos p sin y, sin p) with x horizontal (before the roll),
   // then rolled about its z axis.
@@ -234,7 +289,8 @@ struct SyntheticSequence {
   CameraPath path;          // ground_truth[i].world_from_cam == path.WorldFromCam(i / fps)
 };
 
-// Global photometric state at a time: I = gain * radiance + bias, and the light position.
+// Global photometric state at a time: I = gain * radiance + bias, and the light position. gain
+// and bias include the lighting preset's swing, the auto-exposure gain, contrast and brightness.
 struct Lighting {
   double gain = 1.0;
   double bias = 0.0;

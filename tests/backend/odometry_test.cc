@@ -116,6 +116,7 @@ TEST(OdometryTest, TracksEveryFrameWithSmallAlignedError) {
         << "frame " << frame.index << ": " << FrameStatusName(frame.status) << " " << frame.message;
   }
   EXPECT_EQ(run.stats.lost_events, 0);
+  EXPECT_EQ(run.stats.scale_segments, 1);
   EXPECT_GE(run.stats.keyframes, 1);
   const EvaluationResult eval = EvaluateTrajectory(Sequence().sequence.ground_truth, run.estimate);
   EXPECT_LT(eval.ate_m, kMaxAteM);
@@ -266,6 +267,7 @@ TEST(OdometryTest, BlankFrameIsLostAndTrackingRecovers) {
   }
   EXPECT_EQ(run.stats.lost_events, 1);
   EXPECT_EQ(run.stats.lost_frames, 1);
+  EXPECT_EQ(run.stats.scale_segments, 1);  // no re-initialisation
   // The trajectory after the blank frame continues the one before it (same scale and frame):
   // the error stays within the bounds of the undisturbed run.
   const EvaluationResult eval = EvaluateTrajectory(Sequence().sequence.ground_truth, run.estimate);
@@ -292,12 +294,26 @@ TEST(OdometryTest, LongLossReinitialisesAndContinues) {
   EXPECT_EQ(run.frames[19].status, FrameStatus::kReinitialized);
   EXPECT_EQ(run.stats.reinitializations, 3);
   EXPECT_EQ(run.stats.lost_events, 1);  // one run of consecutive non-tracked frames, 14..19
+  // Frames 0-13 in the first keyframe's scale, 20-35 in the fresh random map's: two segments
+  // (the empty maps of the blank keyframes 15 and 17 track no frame and start none).
+  EXPECT_EQ(run.stats.scale_segments, 2);
   for (int i = 20; i < kFrames; ++i) {
     EXPECT_TRUE(IsTracked(run.frames[i].status)) << "frame " << i << ": " << run.frames[i].message;
   }
   for (const OdometryFrameResult& frame : run.frames) {
     EXPECT_TRUE(frame.world_from_cam.translation().allFinite());
   }
+}
+
+// A re-initialisation that keeps the propagated map (reinit_min_points 0: the propagation is
+// always kept) continues the scale: one segment, however many re-initialisations.
+TEST(OdometryTest, ReinitialisationWithThePropagatedMapKeepsOneScaleSegment) {
+  OdometryConfig config = DeterministicConfig();
+  config.odometry.reinit_after_lost = 2;
+  config.odometry.reinit_min_points = 0;
+  const RunResult run = RunSequence(config, {14, 15});
+  EXPECT_GE(run.stats.reinitializations, 1);
+  EXPECT_EQ(run.stats.scale_segments, 1);
 }
 
 // A global gain and bias per frame (1 +- 0.2 and +-8 gray levels, period 12 frames; float

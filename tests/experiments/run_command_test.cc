@@ -115,6 +115,7 @@ TEST(RunCommandTest, WritesAllOutputs) {
   EXPECT_EQ(summary["tracked"], kFrames);
   EXPECT_GE(summary["keyframes"].get<int>(), 1);
   EXPECT_EQ(summary["lost_events"], 0);
+  EXPECT_EQ(summary["scale_segments"], 1);
   for (const char* object : {"ms_median", "ms_mean"}) {
     for (const char* key : {"detection", "description", "matching", "tracking", "mapping",
                             "tracking_thread", "total"}) {
@@ -400,11 +401,16 @@ TEST(AblateCommandTest, TinyGridWritesTablesAndPlot) {
                       0),
             0u)
       << csv;
+  // The scale segments close the header (appended: scripts read the columns by position), and
+  // neither run of this short sequence re-initialises.
+  EXPECT_NE(csv.find(",dir,scale_segments\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("/lowtex__sdvo,1\n"), std::string::npos) << csv;
   // results.md: the RPE table with one row for the sequence and a column per config.
   const std::string md = Slurp(out / "results.md");
   EXPECT_NE(md.find("| sequence | sdvo | points_lines |"), std::string::npos) << md;
   EXPECT_NE(md.find("| lowtex |"), std::string::npos) << md;
   EXPECT_NE(md.find("### Scale drift"), std::string::npos) << md;
+  EXPECT_NE(md.find("### Scale segments"), std::string::npos) << md;
   // Inline mapping runs on the tracking thread, and the timing table says so.
   EXPECT_NE(md.find("### Median tracking-thread time per frame (ms; mapping inline, included)"),
             std::string::npos)
@@ -433,12 +439,13 @@ TEST(AblateCommandTest, TinyGridWritesTablesAndPlot) {
 
 TEST(AblateCommandTest, RepeatsRunEachPairWithItsOwnInitSeed) {
   // Monocular runs from a random initial map: --repeats 2 runs the pair with mapping.init_seed 1
-  // and 2 and the table gives the median and [min, max].
+  // and 2 and the table gives the median and [min, max]; --run_max_frames caps every run.
   const fs::path config = fs::path(PLDVO_SOURCE_DIR) / "experiments" / "configs" / "sdvo.yaml";
   const fs::path out = TestRoot() / "ablate_repeats";
   const fs::path log = TestRoot() / "ablate_repeats.log";
   ASSERT_EQ(Pldvo("ablate --configs " + config.string() + " --datasets " + SequenceDir().string() +
-                      " --out " + out.string() + " --repeats 2 --jobs 2" + kDeterministic,
+                      " --out " + out.string() + " --repeats 2 --jobs 2 --run_max_frames 34" +
+                      kDeterministic,
                   log),
             0)
       << Slurp(log);
@@ -447,7 +454,9 @@ TEST(AblateCommandTest, RepeatsRunEachPairWithItsOwnInitSeed) {
     const fs::path run = out / "runs" / ("lowtex__sdvo__seed" + std::to_string(seed));
     const std::string effective = Slurp(run / "config.yaml");
     EXPECT_NE(effective.find("init_seed: " + std::to_string(seed)), std::string::npos) << effective;
-    EXPECT_TRUE(fs::exists(run / "summary.json"));
+    ASSERT_TRUE(fs::exists(run / "summary.json"));
+    // --run_max_frames reaches the runs as --max_frames.
+    EXPECT_EQ(nlohmann::json::parse(Slurp(run / "summary.json"))["frames"], 34);
   }
   const std::string md = Slurp(out / "results.md");
   EXPECT_NE(md.find("median and [min, max] over 2 runs"), std::string::npos) << md;
