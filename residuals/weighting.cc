@@ -5,6 +5,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/statistics.h"
+
 namespace pldvo {
 namespace {
 
@@ -37,6 +39,52 @@ std::string WeightingOptions::Check() const {
     error << "robust_threshold must be positive and finite, got " << robust_threshold << "; ";
   }
   return error.str();
+}
+
+double IntensityNoiseFactor(WeightingPolicy policy) {
+  switch (policy) {
+    case WeightingPolicy::kCovariance:
+    case WeightingPolicy::kPhotometricOnly:
+      return 2.0;
+    case WeightingPolicy::kFixedRatio:
+      return 1.0;
+    case WeightingPolicy::kUniform:
+    case WeightingPolicy::kLineOnly:
+      return 0.0;
+  }
+  return 0.0;
+}
+
+double EstimateIntensityNoiseSigma(const std::vector<double>& errors,
+                                   const std::vector<double>& other_variances,
+                                   double noise_factor) {
+  const size_t rows = errors.size();
+  if (rows < static_cast<size_t>(kMinIntensityNoiseRows) || other_variances.size() != rows ||
+      !(noise_factor > 0.0)) {
+    return 0.0;
+  }
+  constexpr double kMadToSigma = 1.4826;
+  std::vector<double> whitened(rows);
+  for (size_t i = 0; i < rows; ++i) whitened[i] = std::abs(errors[i]);
+  const double s0 = kMadToSigma * Median(whitened) / std::sqrt(noise_factor);
+  if (!(s0 > 0.0) || !std::isfinite(s0)) return 0.0;
+  // Robust scale of the whitened errors at sigma; decreasing in sigma, <= 1 at s0.
+  const auto scale = [&](double sigma) {
+    for (size_t i = 0; i < rows; ++i) {
+      whitened[i] = std::abs(errors[i]) /
+                    std::sqrt(noise_factor * sigma * sigma + std::max(other_variances[i], 0.0));
+    }
+    return kMadToSigma * Median(whitened);
+  };
+  double low = kIntensityNoiseFloorFraction * s0;
+  double high = s0;
+  if (scale(low) <= 1.0) return low;
+  // Bisection in log sigma: 40 halvings of the factor 4 leave a relative error below 1e-12.
+  for (int iteration = 0; iteration < 40; ++iteration) {
+    const double mid = std::sqrt(low * high);
+    (scale(mid) > 1.0 ? low : high) = mid;
+  }
+  return std::sqrt(low * high);
 }
 
 EdgeLineWeights SharedLineErrorWeights(const LineWithCovariance& line_in_cur,

@@ -38,6 +38,7 @@ namespace pldvo {
 enum class WeightingPolicy { kCovariance, kUniform, kFixedRatio, kPhotometricOnly, kLineOnly };
 enum class RobustLossKind { kNone, kHuber, kCauchy };
 enum class LineErrorModel { kPerPixel, kSharedPerEdge };
+enum class IntensityNoiseSource { kFixed, kEstimated };
 
 inline const ChoiceNames<WeightingPolicy>& WeightingPolicyNames() {
   static const ChoiceNames<WeightingPolicy> names = {
@@ -54,6 +55,12 @@ inline const ChoiceNames<LineErrorModel>& LineErrorModelNames() {
       {"shared_per_edge", LineErrorModel::kSharedPerEdge}};
   return names;
 }
+inline const ChoiceNames<IntensityNoiseSource>& IntensityNoiseSourceNames() {
+  static const ChoiceNames<IntensityNoiseSource> names = {
+      {"fixed", IntensityNoiseSource::kFixed}, {"estimated", IntensityNoiseSource::kEstimated}};
+  return names;
+}
+
 inline const ChoiceNames<RobustLossKind>& RobustLossKindNames() {
   static const ChoiceNames<RobustLossKind> names = {{"none", RobustLossKind::kNone},
                                                     {"huber", RobustLossKind::kHuber},
@@ -65,6 +72,12 @@ struct WeightingOptions {
   WeightingPolicy policy = WeightingPolicy::kCovariance;
   // sigma_I: image noise per pixel, gray levels (0..255). 4 is LSD-SLAM's cameraPixelNoise.
   double sigma_intensity = 4.0;
+  // Where sigma_I comes from: fixed (sigma_intensity, gray levels: the weights change with the
+  // image's contrast while the line weights, in pixels, do not) or estimated (from the previous
+  // frame's photometric errors at its solution, EstimateIntensityNoiseSigma: scales with the
+  // contrast, so the ratio of photometric to line weights does not; sigma_intensity then only
+  // serves the first frame).
+  IntensityNoiseSource intensity_noise = IntensityNoiseSource::kFixed;
   // "fixed_ratio" only: the pixel scale of a line row, sqrt_info = sqrt(lambda) / line_sigma_px.
   // (The covariance policies take Sigma_l from the matched segment, which the line frontend
   // fits with lines.detector.endpoint_sigma_px.)
@@ -92,6 +105,9 @@ struct WeightingOptions {
              "How photometric and point-to-line residuals are weighted: covariance (the paper), "
              "uniform, fixed_ratio, photometric_only, line_only.");
     v.Field("sigma_intensity", &sigma_intensity, "Image noise sigma_I in gray levels.");
+    v.Choice("intensity_noise", &intensity_noise, IntensityNoiseSourceNames(),
+             "Where sigma_I comes from: fixed (sigma_intensity) or estimated (from the previous "
+             "frame's photometric errors; contrast-invariant weights).");
     v.Field("line_sigma_px", &line_sigma_px,
             "fixed_ratio only: pixel scale of a line row (covariance policies take Sigma_l from "
             "the segments, lines.detector.endpoint_sigma_px).");
@@ -134,6 +150,24 @@ constexpr double kMinPointLineVariance = 1e-4;
 EdgeLineWeights SharedLineErrorWeights(const LineWithCovariance& line_in_cur,
                                        const std::vector<Eigen::Vector2d>& pixels_cur,
                                        const std::vector<double>& point_variances);
+
+// The factor k of the image noise in a photometric row's variance k sigma_I^2 + D, D the rest:
+// 2 for covariance and photometric_only (eq. 5: the noise of both images), 1 for fixed_ratio,
+// 0 where sigma_I does not enter (uniform, line_only).
+double IntensityNoiseFactor(WeightingPolicy policy);
+
+// The image noise sigma_I (gray levels) that the photometric errors e_i at a solution imply,
+// given each row's variance k sigma_I^2 + D_i (k = noise_factor, D_i = other_variances[i], the
+// depth part of eq. 5): the sigma at which the whitened errors have unit robust scale,
+// 1.4826 median_i |e_i| / sqrt(k sigma^2 + D_i) = 1 (the MAD of a unit Gaussian is 1/1.4826).
+// Scaling every e_i by c and every D_i by c^2 (an image scaled in contrast) scales it by c.
+// It lies in [kIntensityNoiseFloorFraction s0, s0], s0 = 1.4826 median |e_i| / sqrt(k) (every
+// D_i zero); the floor when the depth part alone explains the errors. 0 (no estimate) for
+// fewer than kMinIntensityNoiseRows rows, k <= 0 or all errors zero.
+double EstimateIntensityNoiseSigma(const std::vector<double>& errors,
+                                   const std::vector<double>& other_variances, double noise_factor);
+constexpr int kMinIntensityNoiseRows = 50;
+constexpr double kIntensityNoiseFloorFraction = 0.25;
 
 // The robust loss of the options, or nullptr for "none". Pass it to the cost functions (which
 // do not own it) or to ceres::Problem (which does, unless told otherwise).

@@ -81,6 +81,10 @@ Odometry::Odometry(const PinholeCamera& camera, const OdometryConfig& config,
                               : SolverOptions::Type::kGaussNewton;
     compare_tracker_ = std::make_unique<Tracker>(compare);
   }
+  if (config_.odometry.use_lines && config_.odometry.line_consensus_max_cost_drop > 0.0) {
+    consensus_ = std::make_unique<PhotometricConsensus>(
+        config_.tracking, config_.odometry.line_consensus_max_cost_drop);
+  }
   mapper_ = std::make_unique<MappingWorker>(
       camera_, config_.mapping, config_.odometry.parallel_mapping,
       config_.odometry.mapping_queue_size, config_.odometry.wait_for_mapping,
@@ -175,6 +179,7 @@ OdometryFrameResult Odometry::SkipFrame(int index, double timestamp, const std::
 OdometryFrameResult Odometry::Finalize(OdometryFrameResult result) {
   result.timing.mapping_ms = mapper_->TakeRecentJobMs();
   ++stats_.frames;
+  stats_.line_term_drops += result.line_term_dropped;
   const bool tracked = IsTracked(result.status);
   if (tracked) {
     ++stats_.tracked;
@@ -485,6 +490,7 @@ void Odometry::UpdateReference(const std::vector<MatchedLine>& lines_in_cur,
     reference_source_ = map_->reference.get();
   }
   SetMatchedLines(lines_in_cur, &reference_);
+  reference_.intensity_noise_sigma = intensity_noise_sigma_;
   timing->reference_ms = MsSince(start);
 }
 
@@ -511,6 +517,14 @@ TrackingResult Odometry::TrackFrame(const ImagePyramid& pyramid, const cv::Mat& 
       TrackingResult again =
           tracker_.Track(reference_, pyramid, tracking.cur_from_ref, tracking.brightness);
       if (again.status != TrackingStatus::kLost) tracking = std::move(again);
+    }
+  }
+  if (consensus_ != nullptr && result->num_matches > 0 &&
+      tracking.status != TrackingStatus::kLost) {
+    if (std::optional<TrackingResult> photometric =
+            consensus_->Check(reference_, pyramid, tracking)) {
+      tracking = std::move(*photometric);
+      result->line_term_dropped = true;
     }
   }
   result->timing.tracking_ms = MsSince(start);
@@ -540,6 +554,10 @@ void Odometry::AcceptTrackedFrame(int index, const TrackingResult& tracking,
   world_from_last_good_ = world_from_cur;
   last_good_index_ = index;
   brightness_ = tracking.brightness;
+  if (config_.tracking.problem.weighting.intensity_noise == IntensityNoiseSource::kEstimated &&
+      tracking.intensity_noise_sigma > 0.0) {
+    intensity_noise_sigma_ = tracking.intensity_noise_sigma;
+  }
   retry_trigger_.Update(tracking);
   result->world_from_cam = world_from_cur;
   result->status = recovering_ ? FrameStatus::kRecovered : FrameStatus::kTracked;

@@ -39,6 +39,7 @@
 #include "backend/odometry/odometry_config.h"
 #include "backend/odometry/odometry_observer.h"
 #include "backend/odometry/retry_trigger.h"
+#include "backend/tracking/photometric_consensus.h"
 #include "backend/tracking/tracker.h"
 #include "core/image_pyramid.h"
 #include "core/pinhole_camera.h"
@@ -71,6 +72,7 @@ struct OdometryStatistics {
   int edge_ba_line_depth_jobs = 0;
   int edge_ba_line_depths_fused = 0;
   int edge_ba_line_depth_outliers = 0;
+  int line_term_drops = 0;  // frames whose line term the consensus check dropped
 };
 
 class Odometry {
@@ -197,6 +199,8 @@ class Odometry {
   std::unique_ptr<LineFrontend> frontend_;  // matching and tracing (null without lines)
   Tracker tracker_;
   std::unique_ptr<Tracker> compare_tracker_;  // odometry.compare_solver, else null
+  // odometry.line_consensus_max_cost_drop > 0 with lines, else null.
+  std::unique_ptr<PhotometricConsensus> consensus_;
   std::unique_ptr<MappingWorker> mapper_;
   // Edge BA (null when disabled); the adjuster only in parallel mode.
   std::unique_ptr<KeyframeWindow> edge_ba_window_;
@@ -220,6 +224,9 @@ class Odometry {
   // affine; 0 with none and after a new keyframe): the next frame's initial guess, and what its
   // mapping job undoes (MappingJob::brightness).
   AffineBrightness brightness_;
+  // tracking.problem.weighting.intensity_noise estimated: sigma_I of the last tracked frame's
+  // solution (0 until one), given to the tracking reference of the next frame.
+  double intensity_noise_sigma_ = 0.0;
   RetryTrigger retry_trigger_;
   int consecutive_lost_ = 0;
   bool recovering_ = false;   // a frame was lost since the last tracked one

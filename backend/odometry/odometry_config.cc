@@ -15,6 +15,9 @@ std::string KeyframeOptions::Check() const {
 std::string OdometryOptions::Check() const {
   if (num_levels < 1 || num_levels > 8) return "num_levels must be in [1, 8]";
   if (!(line_outlier_px >= 0.0)) return "line_outlier_px must be >= 0";
+  if (!(line_consensus_max_cost_drop >= 0.0) || !std::isfinite(line_consensus_max_cost_drop)) {
+    return "line_consensus_max_cost_drop must be >= 0 and finite";
+  }
   if (!(line_prior_gate_px >= 0.0)) return "line_prior_gate_px must be >= 0";
   if (!(retry_rms_ratio >= 1.0)) return "retry_rms_ratio must be >= 1";
   if (!(alternative_rotation_deg > 0.0 && alternative_rotation_deg < 45.0)) {

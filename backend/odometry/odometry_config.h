@@ -78,6 +78,14 @@ struct OdometryOptions {
   // The same check before tracking at the constant-velocity prior, with this looser gate (the
   // prior is off by the acceleration since the last frame); 0 = off.
   double line_prior_gate_px = 2.0;
+  // The photometric consensus check: after tracking with lines, a photometric-only solve at the
+  // finest level starts from the result. When it lowers the photometric cost (whitened and
+  // robust, 0.5 sum r^2, with the weights of the result's pose) by more than this, the line term
+  // pulled the pose against the photometric evidence, and the frame keeps the photometric pose
+  // (OdometryFrameResult::line_term_dropped). A pose the photometric term leaves free (a
+  // texture-less direction) costs it nothing, so lines keep constraining it there.
+  // chi^2_6 at 99% is 16.8, i.e. 8.4 in cost; 0 = off.
+  double line_consensus_max_cost_drop = 0.0;
   // Alternative initial guesses (besides the constant-velocity prior) are tried when the result
   // is lost, or when its final photometric RMS exceeds retry_rms_ratio times the running mean
   // over recent tracked frames (backend/odometry/retry_trigger.h): zero motion since the last good
@@ -153,6 +161,9 @@ struct OdometryOptions {
     v.Field("line_outlier_px", &line_outlier_px,
             "Unmatch lines whose edge points reproject at a median distance above this (px) "
             "after tracking, and track again; 0 = off (default 2).");
+    v.Field("line_consensus_max_cost_drop", &line_consensus_max_cost_drop,
+            "Drop a frame's line term when a photometric-only solve from its result lowers the "
+            "photometric cost by more than this (0.5 sum r^2; 0 = off).");
     v.Field("line_prior_gate_px", &line_prior_gate_px,
             "Unmatch lines whose edge points reproject at a median distance above this (px) at "
             "the pose prior, before tracking; 0 = off (default 2).");

@@ -58,8 +58,11 @@ struct OdometryFrameResult {
   int keyframe_id = -1;     // the keyframe the frame was tracked against / became
   TrackingResult tracking;  // the chosen tracking result (empty levels when not tracked)
   int alternatives_tried = 0;
-  int num_lines = 0;          // line segments of the frame
-  int num_matches = 0;        // matched to the keyframe
+  int num_lines = 0;    // line segments of the frame
+  int num_matches = 0;  // matched to the keyframe
+  // odometry.line_consensus_max_cost_drop: the line term disagreed with the photometric one and
+  // the frame keeps the photometric-only pose.
+  bool line_term_dropped = false;
   int num_line_outliers = 0;  // matches unmatched by the verification (prior gate + after tracking)
   int num_reference_points = 0;  // level-0 points of the keyframe map
   double mean_idepth = 0.0;      // of the keyframe map

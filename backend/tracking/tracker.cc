@@ -120,7 +120,10 @@ ResidualStatistics EvaluateResidualStatistics(const LeastSquaresProblem& problem
                                    error_valid.data());
       for (int i = 0; i < rows; ++i) {
         const double intensity_ref = photometric->observations()[i].intensity_ref;
-        if (error_valid[i]) cur_ref.emplace_back(intensity_ref - errors[i], intensity_ref);
+        if (!error_valid[i]) continue;
+        cur_ref.emplace_back(intensity_ref - errors[i], intensity_ref);
+        stats.photometric_errors.push_back(errors[i]);
+        stats.photometric_sqrt_info.push_back(photometric->observations()[i].sqrt_info);
       }
     }
     for (int i = 0; i < rows; ++i) {
@@ -168,6 +171,24 @@ Tracker::Tracker(const TrackingOptions& options) : options_(options) {
   if (!error.empty()) throw std::invalid_argument(Where(__LINE__) + "tracking: " + error);
   builder_ = MakeProblemBuilder(options_.problem_builder, options_.problem);
   solver_ = MakeSolver(options_.solver);
+}
+
+double Tracker::IntensityNoiseAtSolution(const TrackingReference& reference,
+                                         const ResidualStatistics& stats) const {
+  const WeightingOptions& weighting = options_.problem.weighting;
+  const double noise_factor = IntensityNoiseFactor(weighting.policy);
+  const double sigma_used = reference.intensity_noise_sigma > 0.0 ? reference.intensity_noise_sigma
+                                                                  : weighting.sigma_intensity;
+  // Each row's variance was noise_factor sigma_used^2 + D_i: recover D_i from its sqrt_info.
+  std::vector<double> errors, other_variances;
+  for (size_t i = 0; i < stats.photometric_errors.size(); ++i) {
+    const double sqrt_info = stats.photometric_sqrt_info[i];
+    if (!(sqrt_info > 0.0)) continue;
+    errors.push_back(stats.photometric_errors[i]);
+    other_variances.push_back(
+        std::max(0.0, 1.0 / (sqrt_info * sqrt_info) - noise_factor * sigma_used * sigma_used));
+  }
+  return EstimateIntensityNoiseSigma(errors, other_variances, noise_factor);
 }
 
 TrackingResult Tracker::Track(const TrackingReference& reference, const ImagePyramid& current,
@@ -240,6 +261,9 @@ TrackingResult Tracker::Track(const TrackingReference& reference, const ImagePyr
     result.levels.push_back(level_result);
     if (options_.pose_covariance && level == options_.finest_level) {
       result.pose_covariance = PoseCovarianceAtSolution(problem, pose);
+    }
+    if (level == options_.finest_level) {
+      result.intensity_noise_sigma = IntensityNoiseAtSolution(reference, final_stats);
     }
   }
 

@@ -122,6 +122,10 @@ struct TrackingResult {
   double intensity_correlation = 0.0;  // the finest level's
   double final_rms = 0.0;
   double final_photometric_rms = 0.0;  // finest level, photometric rows only (0 without any)
+  // The image noise sigma_I (gray levels) the finest level's photometric errors imply at the
+  // solution (EstimateIntensityNoiseSigma); 0 when there are too few rows or sigma_I does not
+  // enter the policy.
+  double intensity_noise_sigma = 0.0;
   // With TrackingOptions::pose_covariance: (J~^T J~)^-1 of the finest level at cur_from_ref,
   // the pose block of it when the brightness is estimated too (whitened, robustified rows, so
   // the inverse of the Gauss-Newton normal matrix); zero otherwise or when J~ is rank deficient.
@@ -141,6 +145,8 @@ struct TrackingIteration {
 };
 using TrackingIterationCallback = std::function<void(const TrackingIteration&)>;
 
+struct ResidualStatistics;
+
 class Tracker {
  public:
   // Throws std::invalid_argument on invalid options or an unknown problem builder.
@@ -157,6 +163,10 @@ class Tracker {
   const TrackingOptions& options() const { return options_; }
 
  private:
+  // TrackingResult::intensity_noise_sigma from the finest level's statistics.
+  double IntensityNoiseAtSolution(const TrackingReference& reference,
+                                  const ResidualStatistics& stats) const;
+
   TrackingOptions options_;
   std::unique_ptr<ProblemBuilder> builder_;
   std::unique_ptr<Solver> solver_;
@@ -178,6 +188,10 @@ struct ResidualStatistics {
   int photometric_valid_rows = 0;
   double intensity_correlation = 0.0;
   double photometric_cost = 0.0;
+  // With `with_intensity_correlation`: the valid photometric rows' errors (no sqrt_info, no
+  // loss) and their sqrt_info.
+  std::vector<double> photometric_errors;
+  std::vector<double> photometric_sqrt_info;
 };
 ResidualStatistics EvaluateResidualStatistics(const LeastSquaresProblem& problem,
                                               double inlier_threshold,

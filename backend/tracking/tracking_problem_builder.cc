@@ -112,7 +112,11 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
   const TrackingReferenceLevel& ref = reference.levels[level];
   const PinholeCamera& camera = ref.camera;
   const SE3 pose = PoseFromParameters(cur_from_ref);
-  const WeightingOptions& weighting = options_.weighting;
+  // The reference's sigma_I, when it has one (weighting.intensity_noise estimated).
+  WeightingOptions weighting = options_.weighting;
+  if (reference.intensity_noise_sigma > 0.0) {
+    weighting.sigma_intensity = reference.intensity_noise_sigma;
+  }
 
   ceres::LossFunction* loss = nullptr;
   if (std::unique_ptr<ceres::LossFunction> made = MakeLossFunction(weighting)) {

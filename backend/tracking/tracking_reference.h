@@ -49,6 +49,10 @@ struct TrackingReferenceLevel {
 
 struct TrackingReference {
   std::vector<TrackingReferenceLevel> levels;  // levels[0] is full resolution
+  // sigma_I of the photometric weights for the frames tracked against it, gray levels; 0: the
+  // configured tracking.problem.weighting.sigma_intensity (weighting.intensity_noise estimated
+  // sets it from the previous frame, EstimateIntensityNoiseSigma).
+  double intensity_noise_sigma = 0.0;
   int num_levels() const { return static_cast<int>(levels.size()); }
 };
 

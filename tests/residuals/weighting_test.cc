@@ -40,8 +40,9 @@ TEST(WeightingOptions, FieldsAndDefaults) {
   EXPECT_EQ(collector.names,
             (std::set<std::string>{"policy", "sigma_intensity", "line_sigma_px",
                                    "fixed_ratio_lambda", "line_error_model", "edge_pixel_sigma_px",
-                                   "robust_loss", "robust_threshold"}));
+                                   "robust_loss", "robust_threshold", "intensity_noise"}));
   EXPECT_EQ(options.Check(), "");
+  EXPECT_EQ(options.intensity_noise, IntensityNoiseSource::kFixed);
   EXPECT_EQ(options.policy, WeightingPolicy::kCovariance);
   EXPECT_EQ(WeightingPolicyNames().size(), 5u);
   options.sigma_intensity = 0.0;
@@ -195,6 +196,100 @@ TEST(Weighting, SharedLineErrorWhitensTheRowsOfAnEdge) {
   }
   EXPECT_GT(mean_correlation, 0.3);
   std::printf("per-pixel model: mean row correlation %.3f\n", mean_correlation);
+}
+
+}  // namespace
+}  // namespace pldvo
+
+namespace pldvo {
+namespace {
+
+// Errors drawn with variance k sigma^2 + D_i: D_i spread over [0, 3 k sigma^2], as the depth
+// term of eq. 5 spreads over a keyframe's points.
+struct NoiseSample {
+  std::vector<double> errors;
+  std::vector<double> other_variances;
+};
+NoiseSample DrawErrors(double sigma, double noise_factor, int rows, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> depth_part(0.0, 3.0 * noise_factor * sigma * sigma);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  NoiseSample sample;
+  for (int i = 0; i < rows; ++i) {
+    const double other = depth_part(rng);
+    sample.other_variances.push_back(other);
+    sample.errors.push_back(std::sqrt(noise_factor * sigma * sigma + other) * unit(rng));
+  }
+  return sample;
+}
+
+TEST(IntensityNoise, RecoversTheImageNoiseUnderADepthTerm) {
+  for (const double sigma : {1.5, 4.0, 12.0}) {
+    const NoiseSample sample = DrawErrors(sigma, 2.0, 20000, 7);
+    // The MAD of n Gaussian draws has a relative standard deviation of about 1.17 / sqrt(n)
+    // (0.8% here); 3% is about 4 of those.
+    EXPECT_NEAR(EstimateIntensityNoiseSigma(sample.errors, sample.other_variances, 2.0), sigma,
+                0.03 * sigma);
+  }
+}
+
+TEST(IntensityNoise, ScalesWithContrastSoTheWeightRatioDoesNot) {
+  const NoiseSample sample = DrawErrors(4.0, 2.0, 4000, 11);
+  const double sigma = EstimateIntensityNoiseSigma(sample.errors, sample.other_variances, 2.0);
+  ASSERT_GT(sigma, 0.0);
+  const Eigen::Vector2d gradient(30.0, -12.0), idepth_jacobian(40.0, 5.0);
+  // A depth part (g^T J_d)^2 V of 13 gray levels^2 against 2 sigma_I^2 of about 32.
+  const double idepth_var = 1e-5;
+  const LineWithCovariance line = FitLine({10.0, 20.0}, {200.0, 60.0}, 1.0);
+  WeightingOptions options;
+  options.sigma_intensity = sigma;
+  const Eigen::Matrix3d pixel_cov = Eigen::Vector3d(0.1, 0.1, 0.0).asDiagonal();
+  const double photometric = PhotometricSqrtInfo(options, gradient, idepth_jacobian, idepth_var);
+  const double line_weight = LineSqrtInfo(options, line, {100.0, 40.0}, pixel_cov);
+  for (const double contrast : {0.5, 0.75, 1.25}) {
+    // The image scaled by c: errors and gradients by c, so the depth part by c^2.
+    NoiseSample scaled = sample;
+    for (double& e : scaled.errors) e *= contrast;
+    for (double& d : scaled.other_variances) d *= contrast * contrast;
+    const double scaled_sigma =
+        EstimateIntensityNoiseSigma(scaled.errors, scaled.other_variances, 2.0);
+    EXPECT_NEAR(scaled_sigma, contrast * sigma, 1e-9 * sigma) << "contrast " << contrast;
+    WeightingOptions scaled_options = options;
+    scaled_options.sigma_intensity = scaled_sigma;
+    // A photometric row's whitened residual, sqrt_info * e, is unchanged; the line rows'
+    // weights (pixels) are unchanged: so is their ratio.
+    const double scaled_photometric =
+        PhotometricSqrtInfo(scaled_options, contrast * gradient, idepth_jacobian, idepth_var);
+    EXPECT_NEAR(scaled_photometric * contrast, photometric, 1e-9 * photometric);
+    EXPECT_EQ(LineSqrtInfo(scaled_options, line, {100.0, 40.0}, pixel_cov), line_weight);
+    // With the fixed sigma_I the ratio moves with the contrast (what the estimate removes).
+    const double fixed_photometric =
+        PhotometricSqrtInfo(options, contrast * gradient, idepth_jacobian, idepth_var);
+    EXPECT_GT(std::abs(fixed_photometric * contrast - photometric), 0.05 * photometric);
+  }
+}
+
+TEST(IntensityNoise, FloorWhenTheDepthTermExplainsTheErrors) {
+  // Errors of exactly the depth part's size: no room for image noise.
+  std::vector<double> errors, other_variances;
+  for (int i = 0; i < 200; ++i) {
+    errors.push_back(i % 2 == 0 ? 3.0 : -3.0);
+    other_variances.push_back(100.0);
+  }
+  const double s0 = 1.4826 * 3.0 / std::sqrt(2.0);
+  EXPECT_DOUBLE_EQ(EstimateIntensityNoiseSigma(errors, other_variances, 2.0),
+                   kIntensityNoiseFloorFraction * s0);
+}
+
+TEST(IntensityNoise, NoEstimateWithoutEnoughRowsOrImageNoise) {
+  const NoiseSample sample = DrawErrors(4.0, 2.0, kMinIntensityNoiseRows - 1, 3);
+  EXPECT_EQ(EstimateIntensityNoiseSigma(sample.errors, sample.other_variances, 2.0), 0.0);
+  const NoiseSample enough = DrawErrors(4.0, 2.0, kMinIntensityNoiseRows, 3);
+  EXPECT_GT(EstimateIntensityNoiseSigma(enough.errors, enough.other_variances, 2.0), 0.0);
+  EXPECT_EQ(EstimateIntensityNoiseSigma(enough.errors, enough.other_variances, 0.0), 0.0);
+  EXPECT_EQ(IntensityNoiseFactor(WeightingPolicy::kCovariance), 2.0);
+  EXPECT_EQ(IntensityNoiseFactor(WeightingPolicy::kFixedRatio), 1.0);
+  EXPECT_EQ(IntensityNoiseFactor(WeightingPolicy::kUniform), 0.0);
 }
 
 }  // namespace
