@@ -1,5 +1,6 @@
 #include "backend/odometry/sequence_runner.h"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -21,11 +22,13 @@
 
 #include "backend/odometry/bootstrap_refiner.h"
 #include "backend/odometry/frame_preparer.h"
+#include "backend/odometry/live_frame_source.h"
 #include "backend/odometry/odometry.h"
 #include "backend/odometry/solver_comparison.h"
 #include "backend/odometry/two_view_bootstrap.h"
 #include "core/config_io.h"
 #include "core/evaluation.h"
+#include "core/statistics.h"
 #include "core/trajectory_io.h"
 #include "core/trajectory_svg.h"
 #include "core/wall_clock.h"
@@ -45,13 +48,6 @@ TimingRow MakeTimingRow(const OdometryTiming& t, double load_ms, double total_ms
           t.description_ms, t.matching_ms,        t.tracing_ms,
           t.wait_ms,        t.reference_ms,       t.tracking_ms,
           t.mapping_ms,     t.tracking_thread_ms, total_ms};
-}
-
-double Mean(const std::vector<double>& values) {
-  if (values.empty()) return 0.0;
-  double sum = 0.0;
-  for (double v : values) sum += v;
-  return sum / values.size();
 }
 
 nlohmann::json NumberOrNull(double value) {
@@ -224,6 +220,48 @@ LoadedFrame LoadFrame(const Dataset& dataset, int index, FramePreparer* preparer
   return loaded;
 }
 
+// The offline feed: every frame in order, frame i + 1 loaded (and prepared) on another thread
+// while frame i is processed. One task runs at a time, so the preparer is never used by two
+// threads at once.
+class PrefetchingFrameSource {
+ public:
+  PrefetchingFrameSource(const Dataset& dataset, int num_frames, FramePreparer* preparer)
+      : dataset_(dataset), num_frames_(num_frames), preparer_(preparer) {
+    if (num_frames_ > 0) next_ = Load(0);
+  }
+  std::optional<std::pair<int, LoadedFrame>> Next() {
+    if (index_ >= num_frames_) return std::nullopt;
+    LoadedFrame frame = next_.get();
+    const int index = index_++;
+    if (index_ < num_frames_) next_ = Load(index_);
+    return std::make_pair(index, std::move(frame));
+  }
+
+ private:
+  std::future<LoadedFrame> Load(int index) {
+    return std::async(std::launch::async, LoadFrame, std::cref(dataset_), index, preparer_);
+  }
+  const Dataset& dataset_;
+  const int num_frames_;
+  FramePreparer* preparer_;
+  int index_ = 0;
+  std::future<LoadedFrame> next_;
+};
+
+// The process's resident memory now and at its peak, MB.
+double CurrentRssMb() {
+  std::ifstream statm("/proc/self/statm");
+  long pages_total = 0, pages_resident = 0;
+  if (!(statm >> pages_total >> pages_resident)) return 0.0;
+  return pages_resident * static_cast<double>(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
+}
+double PeakRssMb() {
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;
+  return usage.ru_maxrss / 1024.0;  // KiB on Linux
+}
+constexpr int kRssSampleFrames = 100;
+
 // One frame through the odometry; a frame that fails to load or process is skipped, said so.
 OdometryFrameResult ProcessLoadedFrame(const Dataset& dataset, const InitialMap& initial,
                                        const OdometryConfig& config, int i, LoadedFrame loaded,
@@ -361,26 +399,31 @@ SequenceRunResult SequenceRunner::Run() {
   std::vector<TimingRow> rows;
   Trajectory estimate;
   int failed = 0;
-  const auto run_start = WallClock::now();
-  // Frame i + 1 is loaded (decoded, undistorted) while frame i is processed, and with
-  // odometry.frontend_thread also prepared (pyramid, line detection and description). One task
-  // runs at a time, so the preparer is never used by two threads at once.
+  std::vector<double> rss_mb;  // every kRssSampleFrames frames
   std::unique_ptr<FramePreparer> preparer;
   if (initial.run_config.odometry.frontend_thread) {
     preparer = std::make_unique<FramePreparer>(initial.run_config);
   }
-  const auto load = [&](int index) {
-    return std::async(std::launch::async, LoadFrame, std::cref(dataset_), index, preparer.get());
-  };
-  std::future<LoadedFrame> next;
-  if (num_frames > 0) next = load(0);
-  for (int i = 0; i < num_frames; ++i) {
-    const auto frame_start = WallClock::now();
-    LoadedFrame loaded = next.get();
-    if (i + 1 < num_frames) next = load(i + 1);
-    const double load_ms = loaded.load_ms;
+  PrefetchingFrameSource offline(dataset_, options_.realtime ? 0 : num_frames, preparer.get());
+  LiveFrameSource<LoadedFrame> live(dataset_, options_.realtime ? num_frames : 0, [&](int index) {
+    return LoadFrame(dataset_, index, preparer.get());
+  });
+  const auto run_start = WallClock::now();
+  if (options_.realtime) live.Start();
+  int processed = 0;
+  while (true) {
+    // Offline, `total` includes waiting for the frame's loading; live, waiting for the camera
+    // is not work.
+    auto frame_start = WallClock::now();
+    std::optional<std::pair<int, LoadedFrame>> next =
+        options_.realtime ? live.Next() : offline.Next();
+    if (!next.has_value()) break;
+    if (options_.realtime) frame_start = WallClock::now();
+    const int i = next->first;
+    const double load_ms = next->second.load_ms;
     const OdometryFrameResult result =
-        ProcessLoadedFrame(dataset_, initial, config_, i, std::move(loaded), &odometry);
+        ProcessLoadedFrame(dataset_, initial, config_, i, std::move(next->second), &odometry);
+    ++processed;
     if (result.status == FrameStatus::kFailed) ++failed;
     if (IsTracked(result.status)) {
       const StampedPose pose{result.timestamp, result.world_from_cam};
@@ -394,6 +437,7 @@ SequenceRunResult SequenceRunner::Run() {
     const TimingRow row = MakeTimingRow(result.timing, load_ms, MsSince(frame_start));
     if (result.status != FrameStatus::kFailed) rows.push_back(row);
     files.AddTimingRow(result, row);
+    if (processed % kRssSampleFrames == 0) rss_mb.push_back(CurrentRssMb());
     progress.Update(i + 1, odometry.statistics().lost_frames);
   }
   odometry.Finish();
@@ -417,11 +461,18 @@ SequenceRunResult SequenceRunner::Run() {
   // Pieces of the trajectory with one scale: a re-initialisation with a fresh random map starts
   // a new one (OdometryStatistics::scale_segments).
   summary["scale_segments"] = stats.scale_segments;
+  summary["line_term_drops"] = stats.line_term_drops;
   summary["dropped_mapping_updates"] = stats.dropped_mapping_updates;
   summary["failed_mapping_jobs"] = stats.failed_mapping_jobs;
   summary["parallel_mapping"] = config_.odometry.parallel_mapping;
   summary["frontend_thread"] = config_.odometry.frontend_thread;
   summary["seconds"] = run_seconds;
+  // --realtime: frames dropped because the odometry could not take them in time.
+  summary["realtime"] = options_.realtime;
+  summary["processed_frames"] = processed;
+  summary["dropped_frames"] = options_.realtime ? live.dropped().size() : 0;
+  summary["peak_rss_mb"] = PeakRssMb();
+  summary["rss_mb_every_100_frames"] = rss_mb;
   // Before the run, not in `seconds`: frames and first-keyframe hypotheses per refinement pass;
   // the two-view bootstrap's second view, triangulated corners, parallax and hypotheses.
   summary["bootstrap"] = initial.bootstrap;

@@ -7,9 +7,9 @@
 //   OUT/groundtruth.txt  the dataset's ground truth (when it has one) in the same frame and
 //                        format, so that evo compares the two files directly;
 //   OUT/timing.csv       one row per frame: status, counts and the time of every component;
-//   OUT/summary.json     at the end: counts, median / mean ms per component, and with ground
-//                        truth rpe_cm_s, rpe_deg_s, ate_m, coverage (Sim(3)-aligned),
-//                        scale_drift and window_scales (1 s windows);
+//   OUT/summary.json     at the end: counts, median / mean ms per component, peak and sampled
+//                        memory (RSS), and with ground truth rpe_cm_s, rpe_deg_s, ate_m,
+//                        coverage (Sim(3)-aligned), scale_drift and window_scales (1 s windows);
 //   OUT/trajectory.svg   top view of the Sim(3)-aligned estimate over the ground truth;
 //   OUT/trajectory_compare.txt  with odometry.compare_solver: the other solver's poses on the
 //                        same tracking problems (summary.json `compare_solver`).
@@ -35,6 +35,9 @@ struct SequenceRunOptions {
   std::string config_label;   // the config file as the user named it (summary)
   int max_frames = 0;         // process only the first N frames (0 = all)
   bool progress = false;      // a progress bar on stderr
+  // Frames fed at their timestamps as a live camera feeds them (LiveFrameSource): what the
+  // odometry cannot take in time is dropped (summary.json `dropped_frames`).
+  bool realtime = false;
 };
 
 // An output of the run could not be written (the run stops; what was written is kept).

@@ -21,6 +21,9 @@
 
 DEFINE_int32(max_frames, 0, "Process only the first N frames (0 = all).");
 DEFINE_bool(progress, true, "Show a progress bar when stderr is a terminal.");
+DEFINE_bool(realtime, false,
+            "Feed the frames at their timestamps, as a live camera does, and drop what the "
+            "odometry cannot take in time (summary.json dropped_frames).");
 DEFINE_bool(list_config, false, "Print every config key with its default and doc, then exit.");
 
 namespace pldvo {
@@ -63,6 +66,7 @@ int RunOdometryCommand(const CommandContext& context) {
     options.config_label = FLAGS_config;
     options.max_frames = FLAGS_max_frames;
     options.progress = FLAGS_progress;
+    options.realtime = FLAGS_realtime;
     SequenceRunner runner(*dataset, config, options, &outputs);
     const SequenceRunResult result = runner.Run();
     PrintRunReport(result, std::cout);

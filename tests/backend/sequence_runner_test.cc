@@ -44,20 +44,20 @@ TEST(SequenceRunnerTest, WritesEveryOutputAndAGroundTruthEvoCanCompare) {
   SequenceRunOptions options;
   options.out_dir = (test::TestRoot() / "runner_all").string();
   options.dataset_label = SequenceDir().string();
-  options.max_frames = 30;
+  options.max_frames = 0;  // all: RPE needs pairs 1 s apart
   SequenceRunner runner(*dataset, DeterministicConfig(), options);
   const SequenceRunResult result = runner.Run();
 
-  EXPECT_EQ(result.frames, 30);
-  EXPECT_EQ(result.tracked, 30);
+  EXPECT_EQ(result.frames, kFrames);
+  EXPECT_EQ(result.tracked, kFrames);
   EXPECT_EQ(result.failed, 0);
-  EXPECT_EQ(result.summary["frames"], 30);
+  EXPECT_EQ(result.summary["frames"], kFrames);
   for (const char* file : {"config.yaml", "trajectory.txt", "groundtruth.txt", "timing.csv",
                            "summary.json", "trajectory.svg"}) {
     EXPECT_TRUE(fs::exists(fs::path(options.out_dir) / file)) << file;
   }
   const Trajectory estimate = ReadTrajectoryTum(options.out_dir + "/trajectory.txt");
-  ASSERT_EQ(estimate.size(), 30u);
+  ASSERT_EQ(estimate.size(), static_cast<size_t>(kFrames));
   // groundtruth.txt is the dataset's ground truth, in the trajectory's frame and format: the
   // comparison of the two files (what evo does) is the run's own evaluation.
   const Trajectory ground_truth = ReadTrajectoryTum(options.out_dir + "/groundtruth.txt");
@@ -75,7 +75,7 @@ TEST(SequenceRunnerTest, WritesEveryOutputAndAGroundTruthEvoCanCompare) {
   EXPECT_NE(svg.str().find("Sim(3)-aligned"), std::string::npos);
   // The report: counts, the component table, the evaluation, the output folder.
   ASSERT_GE(result.report.size(), 3u);
-  EXPECT_NE(result.report[0].find("30 frames, 30 tracked"), std::string::npos) << result.report[0];
+  EXPECT_NE(result.report[0].find("36 frames, 36 tracked"), std::string::npos) << result.report[0];
 }
 
 TEST(SequenceRunnerTest, AnOutputFolderThatCannotBeMadeIsAnOutputError) {

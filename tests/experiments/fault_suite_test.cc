@@ -305,15 +305,17 @@ TEST(FaultSuiteTest, NanInGroundTruthIsRejectedWithFileAndLine) {
                          ": 'nan' is not a finite number");
 }
 
-TEST(FaultSuiteTest, UnknownCameraModelIsRejectedWithFileAndKey) {
+TEST(FaultSuiteTest, UnknownCameraModelIsRejectedWithFileLineAndKey) {
   const fs::path dataset = CopyOf(Sequence(kFrames), "camera_model");
   std::string yaml = Slurp(dataset / "camera.yaml");
   const size_t model = yaml.find("model: pinhole");
   ASSERT_NE(model, std::string::npos) << yaml;
   yaml.replace(model, 14, "model: fisheye");
   WriteText(dataset / "camera.yaml", yaml);
+  const int line = 1 + static_cast<int>(std::count(yaml.begin(), yaml.begin() + model, '\n'));
   ExpectFatalAtStart(RunPldvo(dataset, "run_camera_model"), TestRoot() / "run_camera_model",
-                     (dataset / "camera.yaml").string() + ": key 'model': unknown model 'fisheye'");
+                     (dataset / "camera.yaml").string() + ":" + std::to_string(line) +
+                         ": key 'model': unknown model 'fisheye'");
 }
 
 // A valid camera of the wrong size (--camera tum_fr1 is 640x480): every frame fails to load,
