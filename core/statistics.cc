@@ -16,6 +16,13 @@ double Median(std::vector<double> values) {
   return median;
 }
 
+double UpperMedian(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  return values[mid];
+}
+
 double Mean(const std::vector<double>& values) {
   if (values.empty()) return 0.0;
   double sum = 0.0;

@@ -14,6 +14,11 @@ namespace pldvo {
 // {1, 3, 2} -> 2; {4, 1, 3, 2} -> 2.5 (the mean of 2 and 3); {} -> 0. O(n) (nth_element).
 double Median(std::vector<double> values);
 
+// The sample at rank n / 2 of the sorted values: the median for an odd count, the upper of the
+// two middle values for an even count. A threshold test on a per-edge median (the line gates of
+// backend/odometry/reference_builder.h) compares with one of the samples; {} -> 0. O(n).
+double UpperMedian(std::vector<double> values);
+
 // The arithmetic mean; {} -> 0.
 double Mean(const std::vector<double>& values);
 

@@ -218,7 +218,7 @@ int RemoveLineOutliers(const SE3& cur_from_ref, double max_median_px, TrackingRe
   for (int e = 0; e < num_edges; ++e) {
     std::vector<double>& d = distances[e];
     if (d.empty()) continue;
-    if (Median(d) <= max_median_px) continue;
+    if (UpperMedian(d) <= max_median_px) continue;
     ++removed;
     for (TrackingReferenceLevel& level : reference->levels) {
       if (e < static_cast<int>(level.lines_in_cur.size())) level.lines_in_cur[e].matched = false;

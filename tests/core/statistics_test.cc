@@ -34,6 +34,14 @@ TEST(StatisticsTest, MedianTakesItsArgumentByValue) {
   EXPECT_EQ(values, (std::vector<double>{5.0, 1.0, 4.0, 2.0}));  // the caller's order is kept
 }
 
+TEST(StatisticsTest, UpperMedianIsTheSampleAtRankHalfTheCount) {
+  EXPECT_EQ(UpperMedian({3.0, 1.0, 2.0}), 2.0);
+  // Even count: the upper middle value, where Median takes the mean of the two.
+  EXPECT_EQ(UpperMedian({4.0, 1.0, 3.0, 2.0}), 3.0);
+  EXPECT_EQ(Median({4.0, 1.0, 3.0, 2.0}), 2.5);
+  EXPECT_EQ(UpperMedian({}), 0.0);
+}
+
 TEST(StatisticsTest, Mean) {
   EXPECT_EQ(Mean({}), 0.0);
   EXPECT_EQ(Mean({3.0}), 3.0);
