@@ -1,6 +1,6 @@
 // Reprojection residual of a 3D line in one keyframe for windowed edge bundle adjustment
 // (docs/edge_ba.md; the seed paper's future work, Yang & Scherer, ICRA 2017, Sec. VII). It is
-// the point-to-line distance of the paper's eqs. 4-5 with the roles of point and line swapped:
+// the point-to-line distance of the paper's eq. 3 with the roles of point and line swapped:
 // the line is the projection of a 3D line variable, the points are the keyframe's observed edge
 // pixels x_j (or a segment's two endpoints):
 //

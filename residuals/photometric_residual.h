@@ -1,6 +1,6 @@
 // Photometric residual of a batch of reference pixels against the current image
-// (Yang & Scherer, ICRA 2017, Sec. IV, eqs. 1-7: the photometric term r_i, weighted by the
-// semi-dense VO observation model; see docs/residuals.md):
+// (Yang & Scherer, ICRA 2017, Sec. IV: the photometric term r_i of eq. 2, weighted by the variance
+// Sigma_f of eq. 5, the semi-dense VO observation model; see docs/residuals.md):
 //
 //   r_i = sqrt_info_i * (I_ref(x_i) - I_cur(tau(x_i, d_i, xi))),   i = 1..N,
 //   tau(x, d, xi) = pi(T(xi) pi^-1(x, d)),

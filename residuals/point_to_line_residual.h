@@ -1,6 +1,6 @@
 // Point-to-line residual of a batch of reference edge pixels against matched current-frame
-// lines (Yang & Scherer, ICRA 2017, Sec. IV, eqs. 1-7: the geometric term g_j and its weight;
-// see docs/residuals.md):
+// lines (Yang & Scherer, ICRA 2017, Sec. IV: the geometric term g_j of eq. 3 and its variance
+// Sigma_g of eq. 6; see docs/residuals.md):
 //
 //   g_j = sqrt_info_j * l_j^T (tau(x_j, d_j, xi); 1),   j = 1..N,
 //

@@ -84,7 +84,7 @@ struct WeightingOptions {
   double line_sigma_px = 1.0;
   // lambda of "fixed_ratio": line cost weight relative to the photometric one.
   double fixed_ratio_lambda = 1.0;
-  // How Sigma_l of eq. 7 enters for the policies "covariance" and "line_only":
+  // How Sigma_l enters Sigma_g (eq. 6) for the policies "covariance" and "line_only":
   //   per_pixel        the paper: every pixel's sigma_g^2 = l^T Sigma_x' l + x'^T Sigma_l x', the
   //                    rows independent (an edge of N pixels counts its line error N times);
   //   shared_per_edge  the pixels of an edge share one line error: Cov(g) = D + X Sigma_l X^T
@@ -115,7 +115,7 @@ struct WeightingOptions {
             "Weight of the line cost relative to the photometric cost for policy fixed_ratio.");
     v.Choice("line_error_model", &line_error_model, LineErrorModelNames(),
              "How the line covariance enters (policies covariance, line_only): per_pixel (the "
-             "paper, eq. 7) or shared_per_edge (one line error for all pixels of an edge).");
+             "paper, eq. 6) or shared_per_edge (one line error for all pixels of an edge).");
     v.Field("edge_pixel_sigma_px", &edge_pixel_sigma_px,
             "shared_per_edge: independent error of an edge pixel across its line, px at level 0.");
     v.Choice("robust_loss", &robust_loss, RobustLossKindNames(),

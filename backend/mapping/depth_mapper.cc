@@ -147,8 +147,13 @@ void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
                         edge < static_cast<int>(lines_in_cur.size()) && lines_in_cur[edge].matched;
   if (has_line) {
     ++stats->line_attempts;
-    status = ObserveOnLine(index, geometry, lines_in_cur[edge], idepth_min, idepth_max, &current,
-                           patch_status == StereoStatus::kOk ? &patch : nullptr, &observation);
+    // Without line_stereo_prior_interval only the global bounds apply to the line-guided match;
+    // the fusion's outlier gate judges it against the prior.
+    const bool prior = options_.line_stereo_prior_interval;
+    status =
+        ObserveOnLine(index, geometry, lines_in_cur[edge], prior ? idepth_min : options_.min_idepth,
+                      prior ? idepth_max : options_.max_idepth, &current,
+                      patch_status == StereoStatus::kOk ? &patch : nullptr, &observation);
     if (status == StereoStatus::kOk) {
       ++stats->line_ok;
       if (options_.line_stereo_refine_ssd && patch_status == StereoStatus::kOk) {

@@ -13,8 +13,8 @@
 // paper's Y = beta0 + beta1 X with beta0 = 1/c2, beta1 = -c1/c2). Along the ray of pixel i it
 // predicts d_i = c1 a_i + c2 b_i: linear in c, and the pixel's noise lives along its ray, i.e. in
 // d_i with variance V_i. Hence
-//   Mahalanobis distance (eq. 12):  m_i^2 = (d_i - x_i^T c)^2 / V_i,  x_i = (a_i, b_i),
-//   weighted least squares (eq. 13): c = (X^T W X)^-1 X^T W Y,  X rows x_i^T, Y_i = d_i,
+//   Mahalanobis distance (1-D, for eq. 12):  m_i^2 = (d_i - x_i^T c)^2 / V_i,  x_i = (a_i, b_i),
+//   weighted least squares (for eq. 13): c = (X^T W X)^-1 X^T W Y,  X rows x_i^T, Y_i = d_i,
 //                                    W = diag(1 / V_i),   Cov(c) = (X^T W X)^-1,
 // exact with the true inverse variances as weights (no iteration). RANSAC draws two pixels,
 // solves for c, counts inliers with m_i^2 < gate, then refits on the inliers (twice: the
@@ -31,6 +31,17 @@
 // (if all N errors were identical the fit would be as uncertain as one pixel), which never
 // claims more certainty than the pixel had. The regularisation is applied to a copy of the filter
 // state (DepthMapper::RegularizedMap), never fed back into the EKF.
+//
+// The above is MappingOptions::LineRegularizationMethod::kRay1d (the default). kPaper2d follows
+// the paper's eqs. 11-13 as published: each valid pixel is the point P_i = (a_i, b_i) / d_i of F
+// (eq. 11) with the covariance of its inverse depth mapped along its ray, Sigma_i = s_i^2 u_i
+// u_i^T (u_i the unit in-plane ray, s_i^2 = |(a_i, b_i)|^2 V_i / d_i^4); RANSAC draws two points,
+// takes the line through them and counts the points whose 2-D Mahalanobis distance to it
+// (eq. 12; for a rank-1 Sigma_i, (m^T P_i - o)^2 / (m^T Sigma_i m) with m^T P = o the line) is
+// below the gate; the inliers are then fitted by the closed-form least squares Y = X beta (eq.
+// 13; X rows (1, X_i), Y_i the points' Y, unweighted), twice as above. The result is written in
+// the same form c = (-beta1 / beta0, 1 / beta0) with Cov(c) from s^2 (X^T X)^-1 (s^2 the residual
+// variance), and Regularize updates the inliers as for kRay1d.
 #ifndef PLDVO_BACKEND_MAPPING_LINE_REGULARIZER_H_
 #define PLDVO_BACKEND_MAPPING_LINE_REGULARIZER_H_
 
@@ -85,6 +96,11 @@ class LineRegularizer {
                                      SemiDenseDepthMap* map) const;
 
  private:
+  // The paper's fit (eqs. 11-13) of the valid pixels with in-plane rays `rays`; fills *fit.
+  void FitPaper2d(const std::vector<Eigen::Vector2d>& rays, const std::vector<double>& idepths,
+                  const std::vector<double>& vars, std::vector<uint8_t> valid,
+                  const std::vector<int>& valid_index, std::mt19937* rng, LineFit* fit) const;
+
   MappingOptions options_;
 };
 

@@ -15,6 +15,7 @@ namespace pldvo {
 struct MappingOptions {
   enum class Init { kRandom, kConstant };
   enum class OutlierModel { kValidityCounter, kInlierRatio };
+  enum class LineRegularizationMethod { kRay1d, kPaper2d };
 
   // ---- Pixel selection.
   // A keyframe pixel gets a depth hypothesis when |grad I| (central differences, gray levels per
@@ -85,6 +86,10 @@ struct MappingOptions {
   // current line's in eq. 10, as a part of the observation's error that every line-guided
   // observation of the pixel shares (the same keyframe detection in every frame).
   bool line_stereo_keyframe_line_var = true;
+  // A line-guided match outside the pixel's prior interval (idepth +- search_sigmas sigma) is
+  // dropped, without the SSD fallback. false: only the global [min_idepth, max_idepth] bounds
+  // apply and the EKF's outlier gate decides, as in the paper.
+  bool line_stereo_prior_interval = true;
   // A match is left out for a frame when more than this fraction of its edge's hypotheses (and
   // at least line_match_min_votes of them) put the intersection outside their prior interval: a
   // wrong match (docs/mapping.md, "Wrong frontend matches on textured"). 1 = off.
@@ -131,6 +136,11 @@ struct MappingOptions {
 
   // ---- 3D line regularisation (paper Sec. V-B, eqs. 11-13).
   bool line_regularization = true;
+  // kRay1d: the fit along the pixels' rays with the 1-D Mahalanobis gate in inverse depth
+  // (LineRegularizer, header comment). kPaper2d: the paper's eqs. 11-13, RANSAC with the 2-D
+  // Mahalanobis distance of each point to the line in the edge plane and the closed-form
+  // least-squares fit Y = X beta.
+  LineRegularizationMethod line_regularization_method = LineRegularizationMethod::kRay1d;
   int line_ransac_iterations = 50;
   // Mahalanobis^2 inlier gate, (d_i - d_line_i)^2 / V_i; 6.63 is the 99% chi^2(1) quantile.
   double line_ransac_gate_chi2 = 6.63;
@@ -202,6 +212,9 @@ struct MappingOptions {
     v.Field("line_stereo_keyframe_line_var", &line_stereo_keyframe_line_var,
             "Add the keyframe line's position error to eq. 10, shared by all of the pixel's "
             "line-guided observations (default true).");
+    v.Field("line_stereo_prior_interval", &line_stereo_prior_interval,
+            "Drop line-guided matches outside the prior interval idepth +- search_sigmas sigma; "
+            "false leaves them to the EKF's outlier gate, as the paper (default true).");
     v.Field("line_match_max_outside_fraction", &line_match_max_outside_fraction,
             "Leave a line match out for a frame when more than this fraction of its edge's "
             "hypotheses put the intersection outside their prior interval (1 = off, default).");
@@ -236,6 +249,12 @@ struct MappingOptions {
     v.Field("min_neighbors_fill", &min_neighbors_fill,
             "Fill invalid candidates with at least this many valid neighbours (8).");
     v.Field("line_regularization", &line_regularization, "3D line regularisation of edges.");
+    v.Choice("line_regularization_method", &line_regularization_method,
+             {{"ray_1d", LineRegularizationMethod::kRay1d},
+              {"paper_2d", LineRegularizationMethod::kPaper2d}},
+             "ray_1d: fit along the rays, 1-D gate in inverse depth (default); paper_2d: the "
+             "paper's eqs. 11-13, RANSAC with the 2-D Mahalanobis distance in the edge plane and "
+             "the least-squares fit Y = X beta.");
     v.Field("line_ransac_iterations", &line_ransac_iterations, "RANSAC iterations per edge (50).");
     v.Field("line_ransac_gate_chi2", &line_ransac_gate_chi2,
             "Mahalanobis^2 inlier gate in inverse depth (6.63 = chi2(1) 99%).");

@@ -11,8 +11,9 @@
 //              lost-tracking recovery, threading)
 //   output     OutputOptions (iteration images, keyframe depth PNGs, PLY point clouds)
 //   backend    BackendOptions: edge_ba = EdgeBAOptions (windowed edge bundle adjustment)
-// Defaults are the paper's configuration (experiments/configs/points_lines.yaml is empty of
-// overrides on purpose); docs/configuration.md lists every key.
+// Defaults are experiments/configs/points_lines.yaml (it names no key whose value differs): the
+// paper's method with this implementation's extras, which experiments/configs/paper.yaml switches
+// off (docs/deviations.md); docs/config_keys.md lists every key.
 #ifndef PLDVO_BACKEND_ODOMETRY_ODOMETRY_CONFIG_H_
 #define PLDVO_BACKEND_ODOMETRY_ODOMETRY_CONFIG_H_
 

@@ -1,5 +1,5 @@
-// Hand-written Gauss-Newton on a LeastSquaresProblem (the seed paper's Sec. IV update, cited
-// as eq. 5 in the task):
+// Hand-written Gauss-Newton on a LeastSquaresProblem (the seed paper's Sec. IV update, which the
+// paper does not number; its eq. 5 is the photometric variance Sigma_f):
 //
 //   delta_xi = -(J^T W J)^-1 J^T W E,   x <- Plus(x, delta_xi),
 //

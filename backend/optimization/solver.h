@@ -1,7 +1,7 @@
 // One interface over the two solvers of a LeastSquaresProblem (config `tracking.solver`):
 //   ceres         ceres::Solve with Levenberg-Marquardt on ToCeresProblem();
-//   gauss_newton  the hand-written Gauss-Newton of gauss_newton_solver.h (paper eq. 5 with
-//                 LM-style damping as the step acceptance rule).
+//   gauss_newton  the hand-written Gauss-Newton of gauss_newton_solver.h (the paper's Sec. IV
+//                 update with LM-style damping as the step acceptance rule).
 // Both evaluate the same CostFunction objects and update through the same Manifold::Plus, and
 // both use the same three stopping tolerances with Ceres' definitions:
 //   function:  |cost_old - cost_new| / cost_old <= function_tolerance (after an accepted step);
@@ -40,7 +40,7 @@ struct SolverOptions {
   CeresLinearSolver ceres_linear_solver = CeresLinearSolver::kDenseNormalCholesky;
   int num_threads = 1;
   // Gauss-Newton only: damping lambda of (H + lambda diag(H)) delta = -g. The first step uses
-  // initial_lambda (0: the plain Gauss-Newton step of eq. 5); a step that does not decrease the
+  // initial_lambda (0: the plain Gauss-Newton step); a step that does not decrease the
   // cost is rejected and retried with lambda = max(10 lambda, min_lambda); an accepted step
   // divides lambda by 10 (back to 0 below min_lambda). The solve stops when lambda > max_lambda.
   double initial_lambda = 0.0;
@@ -67,7 +67,7 @@ struct SolverOptions {
              "Ceres linear solver (ceres only).");
     v.Field("num_threads", &num_threads, "Ceres threads for evaluating residuals (ceres only).");
     v.Field("initial_lambda", &initial_lambda,
-            "Gauss-Newton: damping of the first step; 0 is the plain step of eq. 5.");
+            "Gauss-Newton: damping of the first step; 0 is the plain Gauss-Newton step.");
     v.Field("min_lambda", &min_lambda, "Gauss-Newton: damping after the first rejected step.");
     v.Field("max_lambda", &max_lambda, "Gauss-Newton: give up when damping exceeds this.");
     v.Field("max_consecutive_rejections", &max_consecutive_rejections,

@@ -5,7 +5,7 @@
 // map built explicitly by ProblemBuilderRegistry(), no mutable global state.
 //
 // Registered builders (tracking_problem_builder.h):
-//   "tracking"             photometric (eq. 1) and point-to-line (eqs. 4-5) blocks as the
+//   "tracking"             photometric (eq. 2) and point-to-line (eq. 3) blocks as the
 //                          weighting policy says, `batch_size` pixels per residual block, robust
 //                          loss row-wise inside the cost functions, the current image sampled
 //                          with `interpolation`.

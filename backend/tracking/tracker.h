@@ -1,11 +1,12 @@
 // Coarse-to-fine direct tracking of the current frame against a reference keyframe (seed paper
 // Sec. IV). For each pyramid level from `coarsest_level` down to `finest_level`:
 //   1. the problem builder adds the level's photometric and point-to-line residual blocks with
-//      weights (eqs. 6-7) computed at the current estimate, the linearisation point;
-//   2. the solver minimises the weighted robust sum of the photometric (eq. 1) and point-to-line
-//      (eqs. 4-5) residuals by Gauss-Newton steps delta_xi = -(J^T W J)^-1 J^T W E (the update
-//      the task cites as eq. 5), xi <- Exp(delta_xi) * xi, until a tolerance or the iteration
-//      limit is met (SolverOptions); docs/tracking.md discusses the equation numbering;
+//      weights (eqs. 5-6) computed at the current estimate, the linearisation point;
+//   2. the solver minimises the weighted robust sum of the photometric (eq. 2) and point-to-line
+//      (eq. 3) residuals by Gauss-Newton steps delta_xi = -(J^T W J)^-1 J^T W E (the
+//      paper's Sec. IV update, not numbered there), xi <- Exp(delta_xi) * xi, until a tolerance or
+//      the iteration limit is met (SolverOptions); docs/tracking.md discusses the equation
+//      numbering;
 //   3. the estimate seeds the next finer level.
 // After the finest level the valid residuals and the RMS of the whitened (robustified)
 // residuals at the final pose decide the status:

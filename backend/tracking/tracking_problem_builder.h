@@ -1,12 +1,12 @@
 // The tracking problem of one pyramid level (seed paper Sec. IV): for the pose xi = cur_from_ref,
 //
-//   E(xi) = sum_i rho((r_i / sigma_ri)^2) + sum_j rho((g_j / sigma_gj)^2)        (eqs. 1-7)
+//   E(xi) = sum_i rho((r_i / sigma_ri)^2) + sum_j rho((g_j / sigma_gj)^2)        (eq. 1)
 //
 // with the photometric residuals r_i = I_ref(x_i) - I_cur(tau(x_i, d_i, xi)) of every reference
-// point (eq. 1, residuals/photometric_residual.h; I_cur sampled bilinearly or bicubically as
+// point (eq. 2, residuals/photometric_residual.h; I_cur sampled bilinearly or bicubically as
 // `interpolation` says) and the point-to-line residuals
 // g_j = l_j^T tau(x_j, d_j, xi) of every point on an edge with a matched current line
-// (eqs. 4-5, residuals/point_to_line_residual.h). The variances sigma^2 (eqs. 6-7) come from
+// (eq. 3, residuals/point_to_line_residual.h). The variances sigma^2 (eqs. 5-6) come from
 // residuals/weighting.h at the linearisation point (the pose held by the parameter block when
 // Build is called) under the configured policy; a family whose policy weight is 0
 // (photometric_only, line_only) is not added, nor is a row whose weight is 0 at the

@@ -1,7 +1,7 @@
 // What the tracker aligns the current frame to: a reference keyframe's semi-dense points per
 // pyramid level (pixel, inverse depth and its variance, reference intensity, the id of the edge
 // it lies on) and, per level, the current-frame image line matched to each edge (paper Sec. IV:
-// the photometric residuals of eq. 1 use every point, the point-to-line residuals of eqs. 4-5
+// the photometric residuals of eq. 2 use every point, the point-to-line residuals of eq. 3
 // the points whose edge has a matched line).
 //
 // Pyramid convention (core/pinhole_camera.h): level l halves level l-1; a level-l pixel u_l is
@@ -71,7 +71,7 @@ struct GroundTruthReferenceOptions {
   // gray levels per level-l pixel) exceeds this.
   double gradient_threshold = 12.0;
   // Inverse-depth variance given to every GT point, (1/m)^2 (GT is exact; this only sets the
-  // depth term of the covariance weights, eqs. 6-7). 1e-4 is a 1% inverse-depth sigma at 1 m.
+  // depth term of the covariance weights, eqs. 5-6). 1e-4 is a 1% inverse-depth sigma at 1 m.
   double idepth_var = 1e-4;
   // A level-l point's idepth is the mean of its 2^l x 2^l block of level-0 inverse depths
   // (exact on a plane, where inverse depth is affine in the pixel). The block grown by one

@@ -13,7 +13,14 @@
 //                                    with R > 1 the median and [min, max] over the repeats);
 //   OUT/trajectories_<dataset>.svg   top view, Sim(3)-aligned estimates (repeat 1) against
 //                                    ground truth.
+//   OUT/results.json                 per (dataset, config) cell: runs, ok / failed / not-run
+//                                    counts, lost events and the median, min and max of RPE,
+//                                    ATE, scale drift and tracking-thread time over the repeats.
 // --set overrides are passed to every run. Exit status 0 when every run of this shard succeeded.
+// --collect runs nothing: it writes the tables from the runs found in OUT, as the last shard
+// would (a separate step after the shards of a cluster job array, experiments/cluster/
+// ablate.sbatch, docs/cluster.md); it needs the same --configs, --datasets and --repeats, and
+// exits 1 when some run of the grid has no summary.
 #include <fcntl.h>
 #include <gflags/gflags.h>
 #include <spawn.h>
@@ -56,6 +63,9 @@ DEFINE_int32(run_max_frames, 0,
              "Passed to every run as --max_frames: only the first N frames (0 = all).");
 DEFINE_int32(repeats, 1,
              "Runs per pair; repeat k sets mapping.init_seed=k. Tables: median [min, max].");
+DEFINE_bool(collect, false,
+            "Run nothing: write results.csv/.md/.json from the runs found in --out (after the "
+            "shards of a job array).");
 
 namespace pldvo {
 namespace {
@@ -213,6 +223,7 @@ int RunAblate(const CommandContext& context) {
   }
   std::vector<Pair*> mine;
   for (Pair& pair : pairs) {
+    if (FLAGS_collect) break;
     if (pair.index % num_shards != shard) continue;
     if (FLAGS_skip_existing && ReadSummary(pair.dir).is_object()) continue;
     mine.push_back(&pair);
@@ -384,6 +395,61 @@ int RunAblate(const CommandContext& context) {
                          : "Median tracking-thread time per frame (ms)",
           "ms", 1);
   }
+  // results.json: the cells' statistics, machine-readable.
+  {
+    nlohmann::json cells = nlohmann::json::array();
+    for (size_t d = 0; d < datasets.size(); ++d) {
+      for (size_t c = 0; c < configs.size(); ++c) {
+        nlohmann::json cell = {
+            {"dataset", dataset_names[d]}, {"config", config_names[c]}, {"runs", repeats}};
+        int ok = 0, failed = 0, not_run = 0, lost = 0;
+        std::vector<std::vector<double>> values(5);
+        const char* const keys[] = {"rpe_cm_s", "rpe_deg_s", "ate_m", "scale_drift",
+                                    "ms_tracking_thread"};
+        for (int r = 0; r < repeats; ++r) {
+          const int k = static_cast<int>((d * configs.size() + c) * repeats + r);
+          if (statuses[k] == "not_run") {
+            ++not_run;
+            continue;
+          }
+          if (statuses[k] != "ok") {
+            ++failed;
+            continue;
+          }
+          ++ok;
+          const nlohmann::json& s = summaries[k];
+          const double lost_events = JsonNumber(s, "lost_events");
+          if (std::isfinite(lost_events)) lost += static_cast<int>(lost_events);
+          for (int v = 0; v < 5; ++v) {
+            const double value =
+                v == 4 ? (s.contains("ms_median") ? JsonNumber(s["ms_median"], "tracking_thread")
+                                                  : std::nan(""))
+                       : JsonNumber(s, keys[v]);
+            if (std::isfinite(value)) values[v].push_back(value);
+          }
+        }
+        cell["ok"] = ok;
+        cell["failed"] = failed;
+        cell["not_run"] = not_run;
+        cell["lost_events"] = lost;
+        for (int v = 0; v < 5; ++v) {
+          if (values[v].empty()) {
+            cell[keys[v]] = nullptr;
+            continue;
+          }
+          cell[keys[v]] = {{"median", Median(values[v])},
+                           {"min", *std::min_element(values[v].begin(), values[v].end())},
+                           {"max", *std::max_element(values[v].begin(), values[v].end())}};
+        }
+        cells.push_back(std::move(cell));
+      }
+    }
+    const nlohmann::json results = {{"configs", config_names},
+                                    {"datasets", dataset_names},
+                                    {"repeats", repeats},
+                                    {"cells", std::move(cells)}};
+    std::ofstream(out + "/results.json") << results.dump(2) << "\n";
+  }
   // Trajectory plots.
   for (size_t d = 0; d < datasets.size(); ++d) {
     try {
@@ -433,6 +499,14 @@ int RunAblate(const CommandContext& context) {
   std::ifstream md(out + "/results.md");
   std::cout << md.rdbuf();
   bool all_ok = true;
+  if (FLAGS_collect) {
+    const long missing = std::count(statuses.begin(), statuses.end(), std::string("not_run"));
+    if (missing > 0) {
+      std::cerr << "pldvo ablate --collect: " << missing << " of " << pairs.size()
+                << " runs have no summary.json in " << out << "/runs\n";
+      all_ok = false;
+    }
+  }
   for (const Pair* pair : mine) all_ok = all_ok && pair->exit_code == 0;
   return all_ok ? 0 : 1;
 }

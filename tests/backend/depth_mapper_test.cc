@@ -1,12 +1,12 @@
 // Semi-dense mapping on a small synthetic sequence (160x120, 8 frames, textured preset, GT poses)
 // through experiments/evaluation/mapping_evaluation.h: convergence from a random initialisation,
 // line-guided vs photometric stereo on edge pixels, the 3D line regularisation, NEES and
-// propagation. Measured values at this config (pldvo mapeval with the same --set keys) are quoted
-// next to each tolerance; the tolerances leave ~2x margin on them and sit far from what a broken
-// stage gives (the random initialisation has a median relative error of ~60%). The TESTs reading
-// Result() or TexturedSeed2Result() share one evaluation: ctest runs this binary as one process
-// (ONE_PROCESS, tests/CMakeLists.txt), and the evaluations of one sequence render its frames once
-// (the render cache).
+// propagation; line matches outside the prior interval. Measured values at this config (pldvo
+// mapeval with the same --set keys) are quoted next to each tolerance; the tolerances leave ~2x
+// margin on them and sit far from what a broken stage gives (the random initialisation has a median
+// relative error of ~60%). The TESTs reading Result() or TexturedSeed2Result() share one
+// evaluation: ctest runs this binary as one process (ONE_PROCESS, tests/CMakeLists.txt), and the
+// evaluations of one sequence render its frames once (the render cache).
 #include "backend/mapping/depth_mapper.h"
 
 #include <gtest/gtest.h>
@@ -403,6 +403,64 @@ TEST(DepthMapperTest, LineMatchContradictedByTheMapIsLeftOut) {
       EXPECT_TRUE(stats.dropped_line_matches.empty());
     }
   }
+}
+
+// mapping.line_stereo_prior_interval: the keyframe, frame and wrong match of the test above, with
+// the line moved 2 px (6 px puts the intersections outside the global inverse-depth bounds, 0.5
+// px inside the EKF gate) and without the SSD check on line matches (which would see the shifted
+// match first). On (default) the wrong edge's intersections fall outside the pixels' prior
+// intervals and are dropped; off (the paper) only the global bounds apply, so they reach the
+// fusion, whose 2-sigma gate rejects every one of them. Measured: 569 of the edge's 569 pixels
+// either way, at shifts of 1-3 px.
+TEST(DepthMapperTest, LineMatchesOutsideThePriorIntervalAreDroppedOrLeftToTheGate) {
+  const synthetic::SyntheticSequence sequence =
+      synthetic_pairs::MakeScaledSequence("textured", 11, 1, 320, 240);
+  const PinholeCamera& camera = sequence.camera;
+  const synthetic::RenderedFrame keyframe = test::RenderFrameForTest(sequence, 0);
+  const cv::Mat image = test::RenderFrameForTest(sequence, 10).image;
+  const SE3& world_from_ref = sequence.ground_truth[0].world_from_cam;
+  const SE3 cur_from_ref = sequence.ground_truth[10].world_from_cam.Inverse() * world_from_ref;
+  const GroundTruthEdges edges =
+      MakeGroundTruthEdges(synthetic_pairs::SegmentsInCam(sequence.scene, world_from_ref.Inverse()),
+                           keyframe.depth, camera, GroundTruthEdgeOptions());
+  cv::Mat depth = keyframe.depth.clone();
+  for (int y = 0; y < depth.rows; ++y) {
+    for (int x = 0; x < depth.cols; ++x) {
+      const float line_idepth = edges.line_idepth.at<float>(y, x);
+      if (line_idepth > 0.f) depth.at<float>(y, x) = 1.f / line_idepth;
+    }
+  }
+  std::vector<MatchedLine> lines = ProjectGroundTruthLines(edges, camera, cur_from_ref, 0.0, 1);
+  int wrong = -1;
+  size_t most_pixels = 0;
+  for (const TracedLine& line : edges.trace.lines) {
+    if (line.id < static_cast<int>(lines.size()) && lines[line.id].matched &&
+        line.pixels.size() > most_pixels) {
+      most_pixels = line.pixels.size();
+      wrong = line.id;
+    }
+  }
+  ASSERT_GE(wrong, 0);
+  ASSERT_GT(most_pixels, 50u);
+  lines[wrong].line_in_cur.line.z() -= 2.0;
+  FrameUpdateStats stats[2];
+  for (const bool prior_interval : {false, true}) {
+    MappingOptions options;
+    options.line_stereo_check_ssd = false;
+    options.line_stereo_prior_interval = prior_interval;
+    DepthMapper mapper(camera, options);
+    mapper.InitializeKeyframeFromDepth(keyframe.image, edges.trace, depth, 1e-4);
+    stats[prior_interval] = mapper.UpdateWithFrame(image, cur_from_ref, lines);
+  }
+  const FrameUpdateStats& on = stats[1];
+  const FrameUpdateStats& off = stats[0];
+  const int most = static_cast<int>(most_pixels);
+  // 90%: a few of the edge's pixels may lack a hypothesis or leave the image.
+  EXPECT_GT(on.line_out_of_range, 0.9 * most);
+  EXPECT_EQ(off.line_out_of_range, 0);
+  EXPECT_GT(off.line_ok, on.line_ok + 0.9 * most);
+  EXPECT_GT(off.outliers, on.outliers + 0.9 * most);
+  EXPECT_EQ(off.fused, on.fused);  // the gate kept the wrong observations out of the map
 }
 
 TEST(DepthMapperTest, PropagationKeepsAccuracy) {

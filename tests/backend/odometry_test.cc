@@ -130,10 +130,15 @@ TEST(OdometryTest, TracksEveryFrameWithSmallAlignedError) {
 }
 
 // The default monocular initialisation (random inverse depth, large variance): every frame is
-// tracked and the run is usable end to end. Its accuracy is not asserted: whether the depth
-// filter converges to the true structure from a random map within the first keyframe depends
-// on the sequence (docs/odometry.md, "Monocular initialisation"; measured on this one: RPE
-// 4.9 cm/s with the default config, 12.3 cm/s with sdvo.yaml; other settings gave ~20).
+// tracked and the Sim(3)-aligned trajectory is accurate, i.e. the depth filter converged from the
+// random map to the true structure within the first keyframe (docs/odometry.md, "Monocular
+// initialisation"). Measured on this sequence with the default config: ATE 2.9 mm, RPE 2.17 cm/s
+// and 0.97 deg/s, scale drift 1.09. A map that converged to a wrong structure measured RPE ~20
+// cm/s / 6 deg/s (the failure case of other settings); a propagation to the new keyframe that
+// ignores the translation (a bug tried on purpose) still tracks every frame but measured ATE
+// 8.3 mm and scale drift 1.47. The bounds sit at about 2x the measured values (2.5-2.8x for
+// RPE), below both failures: the run is deterministic, so they only need room for
+// floating-point differences across platforms.
 TEST(OdometryTest, MonocularRunTracksEveryFrame) {
   OdometryConfig config;
   config.odometry.parallel_mapping = false;
@@ -145,7 +150,10 @@ TEST(OdometryTest, MonocularRunTracksEveryFrame) {
   EXPECT_EQ(run.stats.lost_events, 0);
   const EvaluationResult eval = EvaluateTrajectory(Sequence().sequence.ground_truth, run.estimate);
   EXPECT_GT(eval.coverage, 0.99);
-  EXPECT_TRUE(std::isfinite(eval.ate_m));
+  EXPECT_LT(eval.ate_m, 0.006);
+  EXPECT_LT(eval.rpe_cm_s, 6.0);
+  EXPECT_LT(eval.rpe_deg_s, 2.5);
+  EXPECT_LT(eval.scale_drift, 1.3);
 }
 
 TEST(OdometryTest, DeterministicModeRepeatsExactly) {
@@ -382,16 +390,22 @@ TEST(OdometryConfigTest, UnknownKeyIsAnError) {
   std::remove(path.c_str());
 }
 
+// The solver switch reaches the config after a shipped file is loaded: none of them names the
+// solver, so each keeps the default (Gauss-Newton), and the override changes it to the other
+// solver (asserting the value the override just set to the default would pass without it).
+// What each file does name is checked in tests/experiments/shipped_configs_test.cc.
 TEST(OdometryConfigTest, ShippedConfigsLoadAndTakeTheSolverSwitch) {
   const std::filesystem::path dir =
       std::filesystem::path(PLDVO_SOURCE_DIR) / "experiments" / "configs";
+  ASSERT_EQ(OdometryConfig().tracking.solver.type, SolverOptions::Type::kGaussNewton);
   for (const char* name :
        {"sdvo", "points_lines", "lines_only", "uniform_weights", "fixed_ratio"}) {
     OdometryConfig config;
     ASSERT_NO_THROW(LoadConfigYaml((dir / (std::string(name) + ".yaml")).string(), &config))
         << name;
-    ASSERT_NO_THROW(ApplyOverrides({"tracking.solver=gauss_newton"}, &config)) << name;
-    EXPECT_EQ(config.tracking.solver.type, SolverOptions::Type::kGaussNewton);
+    EXPECT_EQ(config.tracking.solver.type, SolverOptions::Type::kGaussNewton) << name;
+    ASSERT_NO_THROW(ApplyOverrides({"tracking.solver=ceres"}, &config)) << name;
+    EXPECT_EQ(config.tracking.solver.type, SolverOptions::Type::kCeres) << name;
     EXPECT_EQ(config.Check(), "") << name;
   }
   EXPECT_NE(DescribeConfig(OdometryConfig()).find("keyframes.max_relative_distance"),

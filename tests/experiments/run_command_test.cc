@@ -1,8 +1,9 @@
 // `pldvo run` and `pldvo ablate` end to end through the real binary (PLDVO_BINARY) on a tiny
 // synthetic sequence written in the TUM layout (320x240, 36 frames): every output file, the
 // survival of the trajectory across a corrupt frame mid-run, the ablation tables and plot, and
-// the rejection of an unknown config key. Runs use the deterministic single-thread mapping.
-// `pldvo basin` with the frontend's lines on a few small-gap pairs.
+// the rejection of an unknown config key; a sharded grid collected equals one run. Runs use the
+// deterministic single-thread mapping. `pldvo basin` with the frontend's lines on a few small-gap
+// pairs.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -466,6 +467,60 @@ TEST(AblateCommandTest, RepeatsRunEachPairWithItsOwnInitSeed) {
                       " --out " + out.string() + " --repeats 0",
                   log),
             2);
+}
+
+// A grid split into shards that run one after another on a shared output folder, then
+// `--collect`, gives the results of one unsharded run (deterministic mode): results.csv equal
+// field by field except the timing columns (wall-clock) and the run folder (another OUT), and
+// results.json's non-timing statistics equal. Grid: 2 configs x 1 sequence x 2 repeats.
+TEST(AblateCommandTest, ShardsThenCollectGiveTheResultsOfOneRun) {
+  const fs::path configs = fs::path(PLDVO_SOURCE_DIR) / "experiments" / "configs";
+  const std::string grid = " --configs " + (configs / "sdvo.yaml").string() + "," +
+                           (configs / "points_lines.yaml").string() + " --datasets " +
+                           SequenceDir().string() + " --repeats 2" + kDeterministic;
+  const fs::path one = TestRoot() / "ablate_one", sharded = TestRoot() / "ablate_sharded";
+  const fs::path log = TestRoot() / "ablate_shards.log";
+  ASSERT_EQ(Pldvo("ablate" + grid + " --out " + one.string() + " --jobs 2", log), 0) << Slurp(log);
+  // Collecting before every shard ran reports the missing runs.
+  ASSERT_EQ(Pldvo("ablate" + grid + " --out " + sharded.string() + " --shard 0/2", log), 0)
+      << Slurp(log);
+  EXPECT_EQ(Pldvo("ablate" + grid + " --out " + sharded.string() + " --collect", log), 1);
+  EXPECT_NE(Slurp(log).find("2 of 4 runs have no summary.json"), std::string::npos) << Slurp(log);
+  ASSERT_EQ(
+      Pldvo("ablate" + grid + " --out " + sharded.string() + " --shard 1/2 --skip_existing", log),
+      0)
+      << Slurp(log);
+  fs::remove(sharded / "results.csv");
+  fs::remove(sharded / "results.json");
+  ASSERT_EQ(Pldvo("ablate" + grid + " --out " + sharded.string() + " --collect", log), 0)
+      << Slurp(log);
+
+  const auto expected = CsvRows(one / "results.csv"), actual = CsvRows(sharded / "results.csv");
+  ASSERT_EQ(expected.size(), 4u);
+  ASSERT_EQ(actual.size(), expected.size());
+  // Columns: ..., 12 ms_median_tracking_thread, 13 ms_median_total, 14 init_seed, 15 dir.
+  for (size_t row = 0; row < expected.size(); ++row) {
+    ASSERT_EQ(actual[row].size(), 16u);
+    ASSERT_EQ(expected[row].size(), 16u);
+    EXPECT_EQ(expected[row][2], "ok") << "row " << row;
+    for (size_t column = 0; column < 15; ++column) {
+      if (column == 12 || column == 13) continue;
+      EXPECT_EQ(actual[row][column], expected[row][column])
+          << "row " << row << " column " << column;
+    }
+  }
+  const nlohmann::json a = nlohmann::json::parse(Slurp(one / "results.json"));
+  const nlohmann::json b = nlohmann::json::parse(Slurp(sharded / "results.json"));
+  ASSERT_EQ(a["cells"].size(), 2u);
+  ASSERT_EQ(b["cells"].size(), 2u);
+  for (size_t cell = 0; cell < 2; ++cell) {
+    for (const char* key : {"dataset", "config", "runs", "ok", "failed", "not_run", "lost_events",
+                            "rpe_cm_s", "rpe_deg_s", "ate_m", "scale_drift"}) {
+      EXPECT_EQ(a["cells"][cell][key], b["cells"][cell][key]) << "cell " << cell << " " << key;
+    }
+    EXPECT_EQ(b["cells"][cell]["ok"], 2);
+    EXPECT_TRUE(b["cells"][cell]["ms_tracking_thread"].is_object());
+  }
 }
 
 TEST(BasinCommandTest, FrontendLinesTrackSmallGapsToTheTruth) {

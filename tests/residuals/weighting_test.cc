@@ -72,8 +72,19 @@ TEST(WeightingOptions, LossFunctions) {
   EXPECT_NEAR(rho[0], 4.0 * std::log1p(9.0 / 4.0), 1e-12);
 }
 
+// The expected weights are written out from the formulas with these numbers, not computed with
+// the functions under test:
+//   photometric (eq. 5): Sigma_f = 2 sigma_I^2 + (g^T J)^2 V with g = (12, -5), J = (20, -8),
+//     V = 1e-3: g^T J = 240 + 40 = 280, Sigma_f = 2 * 9 + 78400e-3 = 96.4;
+//   point-to-line (eq. 6): Sigma_g = l^T Sigma_x l + x^T Sigma_l x. The line through (10, 10)
+//     and (60, 30) has the unit normal (-20, 50) / sqrt(2900); Sigma_x = V J J^T, so
+//     l^T Sigma_x l = 1e-3 (-20 * 20 + 50 * -8)^2 / 2900 = 0.64 / 2.9. For endpoints with
+//     N(0, sigma^2 I) noise a point's distance to the line moves by (1 - t) e1 + t e2 (e1, e2
+//     the endpoints' perpendicular errors, t the position of its foot on the segment), so
+//     x^T Sigma_l x = sigma^2 ((1 - t)^2 + t^2); for x = (40, 25), t = (30 * 50 + 15 * 20) / 2900
+//     = 18 / 29, giving (11^2 + 18^2) / 29^2 = 445 / 841.
 TEST(Weighting, PoliciesFromCovarianceInputs) {
-  const Eigen::Vector2d gradient(12.0, -5.0), idepth_jacobian(20.0, 8.0);
+  const Eigen::Vector2d gradient(12.0, -5.0), idepth_jacobian(20.0, -8.0);
   constexpr double kIdepthVar = 1e-3;
   const LineWithCovariance line = FitLine(Eigen::Vector2d(10, 10), Eigen::Vector2d(60, 30), 1.0);
   const Eigen::Vector2d pixel(40.0, 25.0);
@@ -83,10 +94,8 @@ TEST(Weighting, PoliciesFromCovarianceInputs) {
   options.sigma_intensity = 3.0;
   options.line_sigma_px = 1.0;
   options.fixed_ratio_lambda = 4.0;
-  const double photometric_cov =
-      1.0 / std::sqrt(PhotometricVariance(3.0, gradient, idepth_jacobian, kIdepthVar));
-  const double line_cov =
-      1.0 / std::sqrt(PointToLineVariance(line.line, line.cov, pixel, pixel_cov));
+  const double photometric_cov = 1.0 / std::sqrt(96.4);
+  const double line_cov = 1.0 / std::sqrt(0.64 / 2.9 + 445.0 / 841.0);
   struct Expected {
     WeightingPolicy policy;
     double photometric;
@@ -98,9 +107,10 @@ TEST(Weighting, PoliciesFromCovarianceInputs) {
                             Expected{WeightingPolicy::kPhotometricOnly, photometric_cov, 0.0},
                             Expected{WeightingPolicy::kLineOnly, 0.0, line_cov}}) {
     options.policy = e.policy;
-    EXPECT_DOUBLE_EQ(PhotometricSqrtInfo(options, gradient, idepth_jacobian, kIdepthVar),
-                     e.photometric);
-    EXPECT_DOUBLE_EQ(LineSqrtInfo(options, line, pixel, pixel_cov), e.line);
+    // Relative 1e-12: the formulas above in another order of floating-point operations.
+    EXPECT_NEAR(PhotometricSqrtInfo(options, gradient, idepth_jacobian, kIdepthVar), e.photometric,
+                1e-12 * e.photometric);
+    EXPECT_NEAR(LineSqrtInfo(options, line, pixel, pixel_cov), e.line, 1e-12 * e.line);
     EXPECT_EQ(UsesPhotometric(e.policy), e.photometric != 0.0);
     EXPECT_EQ(UsesLines(e.policy), e.line != 0.0);
   }
@@ -137,7 +147,7 @@ TEST(Weighting, GeometryConvenienceMatchesComposition) {
 // Monte Carlo of one edge: N pixels x_j on a segment, the detected line fitted to endpoints with
 // N(0, sigma^2 I) noise (FitLine, shared by every pixel) and an independent point error of
 // variance s_j per pixel, g_j = l'^T x_j + sqrt(s_j) z_j. SharedLineErrorWeights must whiten g
-// to identity covariance; the per-pixel model (eq. 7: each row alone, 1 / sqrt(s_j + x^T Sigma_l
+// to identity covariance; the per-pixel model (eq. 6: each row alone, 1 / sqrt(s_j + x^T Sigma_l
 // x)) gets each row's variance right but leaves the rows strongly correlated, so it counts the
 // one line error once per pixel.
 TEST(Weighting, SharedLineErrorWhitensTheRowsOfAnEdge) {
@@ -185,7 +195,7 @@ TEST(Weighting, SharedLineErrorWhitensTheRowsOfAnEdge) {
   // Each entry of a 20000-sample covariance has a standard error of ~0.007 (0.01 on the
   // diagonal); 0.05 is > 5 of them.
   EXPECT_LT((shared_cov - Eigen::MatrixXd::Identity(kPixels, kPixels)).cwiseAbs().maxCoeff(), 0.05);
-  // Per pixel: each row alone has variance 1 (eq. 7 is right row by row) ...
+  // Per pixel: each row alone has variance 1 (eq. 6 is right row by row) ...
   EXPECT_LT((per_pixel_cov.diagonal().array() - 1.0).abs().maxCoeff(), 0.05);
   // ... but neighbouring rows share the line error: correlations far from 0.
   double mean_correlation = 0.0;
