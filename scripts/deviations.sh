@@ -10,7 +10,8 @@
 # (mapping.init_seed 1..3), inline mapping (deterministic).
 # Larger: PLDVO_DEV_FRAMES=300 PLDVO_DEV_WIDTH=640 PLDVO_DEV_HEIGHT=480 PLDVO_DEV_REPEATS=5, or the
 # cluster (docs/cluster.md: the grid's configs are in $dir/configs after the first step).
-# Needs python3 with PyYAML (Debian: python3-yaml) to write the config variants.
+# Needs python3 with PyYAML (Debian: python3-yaml, which scripts/install_deps.sh installs) to
+# write the config variants.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${PLDVO_BUILD_DIR:-build}

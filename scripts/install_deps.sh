@@ -6,7 +6,7 @@ packages=(
   build-essential cmake ninja-build pkg-config clang clang-format libclang-rt-14-dev
   libceres-dev libeigen3-dev libsuitesparse-dev libgflags-dev libgoogle-glog-dev
   libopencv-dev libopencv-contrib-dev libgtest-dev libgmock-dev libbenchmark-dev
-  nlohmann-json3-dev libzip-dev libyaml-cpp-dev
+  nlohmann-json3-dev libzip-dev python3-yaml libyaml-cpp-dev
 )
 missing=()
 for p in "${packages[@]}"; do

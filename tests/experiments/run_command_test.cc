@@ -498,13 +498,14 @@ TEST(AblateCommandTest, ShardsThenCollectGiveTheResultsOfOneRun) {
   const auto expected = CsvRows(one / "results.csv"), actual = CsvRows(sharded / "results.csv");
   ASSERT_EQ(expected.size(), 4u);
   ASSERT_EQ(actual.size(), expected.size());
-  // Columns: ..., 12 ms_median_tracking_thread, 13 ms_median_total, 14 init_seed, 15 dir.
+  // Columns: ..., 12 ms_median_tracking_thread, 13 ms_median_total, 14 init_seed, 15 dir,
+  // 16 scale_segments: all but the times and the run folder must agree.
   for (size_t row = 0; row < expected.size(); ++row) {
-    ASSERT_EQ(actual[row].size(), 16u);
-    ASSERT_EQ(expected[row].size(), 16u);
+    ASSERT_EQ(actual[row].size(), 17u);
+    ASSERT_EQ(expected[row].size(), 17u);
     EXPECT_EQ(expected[row][2], "ok") << "row " << row;
-    for (size_t column = 0; column < 15; ++column) {
-      if (column == 12 || column == 13) continue;
+    for (size_t column = 0; column < 17; ++column) {
+      if (column == 12 || column == 13 || column == 15) continue;
       EXPECT_EQ(actual[row][column], expected[row][column])
           << "row " << row << " column " << column;
     }
