@@ -13,7 +13,7 @@
 //
 // (the same rows when a = b = 0). Both images are noisy: with e^a I_ref + b - I_cur the
 // least-squares gain would be the ordinary regression slope of I_cur on I_ref, which the noise
-// of I_ref attenuates (measured 1.4% low on a textured pair, about 5% on lowtex); the factor
+// of I_ref attenuates (docs/tracking.md, affine brightness); the factor
 // e^{-a/2} treats the two images alike and makes it sqrt(S_cur / S_ref) (reduced major axis),
 // exact at unit gain when both have the same noise.
 //
