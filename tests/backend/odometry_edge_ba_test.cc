@@ -18,8 +18,8 @@
 #include "backend/odometry/odometry_config.h"
 #include "core/config_io.h"
 #include "core/evaluation.h"
-#include "experiments/synthetic/synthetic_sequence.h"
 #include "core/statistics.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 #include "tests/backend/rendered_sequence.h"
 #include "tests/render_cache.h"
 

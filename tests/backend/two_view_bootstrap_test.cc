@@ -13,8 +13,8 @@
 #include "backend/odometry/odometry_config.h"
 #include "core/dataset.h"
 #include "core/evaluation.h"
-#include "experiments/synthetic/synthetic_sequence.h"
 #include "core/statistics.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 #include "tests/render_cache.h"
 #include "tests/small_lowtex_options.h"
 

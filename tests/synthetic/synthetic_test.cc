@@ -18,8 +18,8 @@
 #include <utility>
 #include <vector>
 
-#include "experiments/synthetic/synthetic_sequence.h"
 #include "core/statistics.h"
+#include "experiments/synthetic/synthetic_sequence.h"
 
 namespace pldvo::synthetic {
 namespace {
