@@ -354,47 +354,75 @@ TEST(DepthMapperTest, ExactCurrentLinesMakeTheTexturedEdgesMoreAccurate) {
   EXPECT_THROW(Evaluate(config), std::invalid_argument);
 }
 
+// The keyframe of the two wrong-match tests below: frame 0 of a small textured sequence from its
+// GT depth (traced pixels hold the depth of their 3D line, as line-guided stereo leaves them),
+// its GT edges, frame 10 with the exact GT lines of its pose, and `wrong`, the matched edge with
+// the most traced pixels (the one a test moves).
+struct WrongMatchCase {
+  PinholeCamera camera;
+  cv::Mat keyframe_image;
+  cv::Mat image;
+  SE3 cur_from_ref;
+  GroundTruthEdges edges;
+  cv::Mat depth;
+  std::vector<MatchedLine> lines;
+  int wrong = -1;
+  size_t wrong_pixels = 0;
+};
+
+WrongMatchCase MakeWrongMatchCase() {
+  const synthetic::SyntheticSequence sequence =
+      synthetic_pairs::MakeScaledSequence("textured", 11, 1, 320, 240);
+  WrongMatchCase c;
+  c.camera = sequence.camera;
+  const synthetic::RenderedFrame keyframe = test::RenderFrameForTest(sequence, 0);
+  c.keyframe_image = keyframe.image;
+  c.image = test::RenderFrameForTest(sequence, 10).image;
+  const SE3& world_from_ref = sequence.ground_truth[0].world_from_cam;
+  c.cur_from_ref = sequence.ground_truth[10].world_from_cam.Inverse() * world_from_ref;
+  c.edges =
+      MakeGroundTruthEdges(synthetic_pairs::SegmentsInCam(sequence.scene, world_from_ref.Inverse()),
+                           keyframe.depth, c.camera, GroundTruthEdgeOptions());
+  c.depth = keyframe.depth.clone();
+  for (int y = 0; y < c.depth.rows; ++y) {
+    for (int x = 0; x < c.depth.cols; ++x) {
+      const float line_idepth = c.edges.line_idepth.at<float>(y, x);
+      if (line_idepth > 0.f) c.depth.at<float>(y, x) = 1.f / line_idepth;
+    }
+  }
+  c.lines = ProjectGroundTruthLines(c.edges, c.camera, c.cur_from_ref, 0.0, 1);
+  for (const TracedLine& line : c.edges.trace.lines) {
+    if (line.id < static_cast<int>(c.lines.size()) && c.lines[line.id].matched &&
+        line.pixels.size() > c.wrong_pixels) {
+      c.wrong_pixels = line.pixels.size();
+      c.wrong = line.id;
+    }
+  }
+  return c;
+}
+
 TEST(DepthMapperTest, LineMatchContradictedByTheMapIsLeftOut) {
   // A keyframe from its GT depth (sigma 0.01 per metre; traced pixels hold the depth of their 3D
   // line, as line-guided stereo leaves them), its GT edges and the exact GT lines of frame 10, but
   // one edge's line moved 6 px along its normal (a wrong match, like a neighbouring texture line).
   // Its intersections leave every pixel's prior interval, so with
   // line_match_max_outside_fraction 0.8 that match alone is left out; off (1), none is.
-  const synthetic::SyntheticSequence sequence =
-      synthetic_pairs::MakeScaledSequence("textured", 11, 1, 320, 240);
-  const PinholeCamera& camera = sequence.camera;
-  const synthetic::RenderedFrame keyframe = test::RenderFrameForTest(sequence, 0);
-  const cv::Mat image = test::RenderFrameForTest(sequence, 10).image;
-  const SE3& world_from_ref = sequence.ground_truth[0].world_from_cam;
-  const SE3 cur_from_ref = sequence.ground_truth[10].world_from_cam.Inverse() * world_from_ref;
-  const GroundTruthEdges edges =
-      MakeGroundTruthEdges(synthetic_pairs::SegmentsInCam(sequence.scene, world_from_ref.Inverse()),
-                           keyframe.depth, camera, GroundTruthEdgeOptions());
-  cv::Mat depth = keyframe.depth.clone();
-  for (int y = 0; y < depth.rows; ++y) {
-    for (int x = 0; x < depth.cols; ++x) {
-      const float line_idepth = edges.line_idepth.at<float>(y, x);
-      if (line_idepth > 0.f) depth.at<float>(y, x) = 1.f / line_idepth;
-    }
-  }
-  std::vector<MatchedLine> lines = ProjectGroundTruthLines(edges, camera, cur_from_ref, 0.0, 1);
-  int wrong = -1;
-  size_t most_pixels = 0;
-  for (const TracedLine& line : edges.trace.lines) {
-    if (line.id < static_cast<int>(lines.size()) && lines[line.id].matched &&
-        line.pixels.size() > most_pixels) {
-      most_pixels = line.pixels.size();
-      wrong = line.id;
-    }
-  }
+  WrongMatchCase c = MakeWrongMatchCase();
+  const PinholeCamera& camera = c.camera;
+  const cv::Mat& image = c.image;
+  const SE3& cur_from_ref = c.cur_from_ref;
+  const GroundTruthEdges& edges = c.edges;
+  const cv::Mat& depth = c.depth;
+  std::vector<MatchedLine>& lines = c.lines;
+  const int wrong = c.wrong;
   ASSERT_GE(wrong, 0);
-  ASSERT_GT(most_pixels, 50u);
+  ASSERT_GT(c.wrong_pixels, 50u);
   lines[wrong].line_in_cur.line.z() -= 6.0;  // l = (a, b, c) with a^2 + b^2 = 1
   for (double fraction : {0.5, 1.0}) {
     MappingOptions options;
     options.line_match_max_outside_fraction = fraction;
     DepthMapper mapper(camera, options);
-    mapper.InitializeKeyframeFromDepth(keyframe.image, edges.trace, depth, 1e-4);
+    mapper.InitializeKeyframeFromDepth(c.keyframe_image, edges.trace, depth, 1e-4);
     const FrameUpdateStats stats = mapper.UpdateWithFrame(image, cur_from_ref, lines);
     EXPECT_GT(stats.line_ok, 1000);
     if (fraction < 1.0) {
@@ -413,35 +441,16 @@ TEST(DepthMapperTest, LineMatchContradictedByTheMapIsLeftOut) {
 // fusion, whose 2-sigma gate rejects every one of them. Measured: 569 of the edge's 569 pixels
 // either way, at shifts of 1-3 px.
 TEST(DepthMapperTest, LineMatchesOutsideThePriorIntervalAreDroppedOrLeftToTheGate) {
-  const synthetic::SyntheticSequence sequence =
-      synthetic_pairs::MakeScaledSequence("textured", 11, 1, 320, 240);
-  const PinholeCamera& camera = sequence.camera;
-  const synthetic::RenderedFrame keyframe = test::RenderFrameForTest(sequence, 0);
-  const cv::Mat image = test::RenderFrameForTest(sequence, 10).image;
-  const SE3& world_from_ref = sequence.ground_truth[0].world_from_cam;
-  const SE3 cur_from_ref = sequence.ground_truth[10].world_from_cam.Inverse() * world_from_ref;
-  const GroundTruthEdges edges =
-      MakeGroundTruthEdges(synthetic_pairs::SegmentsInCam(sequence.scene, world_from_ref.Inverse()),
-                           keyframe.depth, camera, GroundTruthEdgeOptions());
-  cv::Mat depth = keyframe.depth.clone();
-  for (int y = 0; y < depth.rows; ++y) {
-    for (int x = 0; x < depth.cols; ++x) {
-      const float line_idepth = edges.line_idepth.at<float>(y, x);
-      if (line_idepth > 0.f) depth.at<float>(y, x) = 1.f / line_idepth;
-    }
-  }
-  std::vector<MatchedLine> lines = ProjectGroundTruthLines(edges, camera, cur_from_ref, 0.0, 1);
-  int wrong = -1;
-  size_t most_pixels = 0;
-  for (const TracedLine& line : edges.trace.lines) {
-    if (line.id < static_cast<int>(lines.size()) && lines[line.id].matched &&
-        line.pixels.size() > most_pixels) {
-      most_pixels = line.pixels.size();
-      wrong = line.id;
-    }
-  }
+  WrongMatchCase c = MakeWrongMatchCase();
+  const PinholeCamera& camera = c.camera;
+  const cv::Mat& image = c.image;
+  const SE3& cur_from_ref = c.cur_from_ref;
+  const GroundTruthEdges& edges = c.edges;
+  const cv::Mat& depth = c.depth;
+  std::vector<MatchedLine>& lines = c.lines;
+  const int wrong = c.wrong;
   ASSERT_GE(wrong, 0);
-  ASSERT_GT(most_pixels, 50u);
+  ASSERT_GT(c.wrong_pixels, 50u);
   lines[wrong].line_in_cur.line.z() -= 2.0;
   FrameUpdateStats stats[2];
   for (const bool prior_interval : {false, true}) {
@@ -449,12 +458,12 @@ TEST(DepthMapperTest, LineMatchesOutsideThePriorIntervalAreDroppedOrLeftToTheGat
     options.line_stereo_check_ssd = false;
     options.line_stereo_prior_interval = prior_interval;
     DepthMapper mapper(camera, options);
-    mapper.InitializeKeyframeFromDepth(keyframe.image, edges.trace, depth, 1e-4);
+    mapper.InitializeKeyframeFromDepth(c.keyframe_image, edges.trace, depth, 1e-4);
     stats[prior_interval] = mapper.UpdateWithFrame(image, cur_from_ref, lines);
   }
   const FrameUpdateStats& on = stats[1];
   const FrameUpdateStats& off = stats[0];
-  const int most = static_cast<int>(most_pixels);
+  const int most = static_cast<int>(c.wrong_pixels);
   // 90%: a few of the edge's pixels may lack a hypothesis or leave the image.
   EXPECT_GT(on.line_out_of_range, 0.9 * most);
   EXPECT_EQ(off.line_out_of_range, 0);
