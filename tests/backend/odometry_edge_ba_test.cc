@@ -22,6 +22,7 @@
 #include "experiments/synthetic/synthetic_sequence.h"
 #include "tests/backend/rendered_sequence.h"
 #include "tests/render_cache.h"
+#include "tests/sanitizer_budget.h"
 
 namespace pldvo {
 namespace {
@@ -111,6 +112,7 @@ RunResult RunSequence(const OdometryConfig& config, OdometryObserver* observer =
 }
 
 TEST(OdometryEdgeBATest, AppliesResultsAndIsNotWorseThanWithout) {
+  PLDVO_RELEASE_ONLY_ACCURACY_TEST("OdometryEdgeBATest.SynchronousModeRepeatsExactly");
   EdgeDepthObserver depth_without, depth_no_feedback, depth_with;
   const RunResult without = RunSequence(Config(false), &depth_without, kAccuracyFrames);
   const RunResult with = RunSequence(Config(true), &depth_with, kAccuracyFrames);

@@ -24,6 +24,7 @@
 #include "core/statistics.h"
 #include "experiments/synthetic/synthetic_sequence.h"
 #include "tests/backend/rendered_sequence.h"
+#include "tests/sanitizer_budget.h"
 
 namespace pldvo {
 namespace {
@@ -109,6 +110,7 @@ constexpr double kMaxRpeCmS = 3.0;
 constexpr double kMaxRpeDegS = 1.5;
 
 TEST(OdometryTest, TracksEveryFrameWithSmallAlignedError) {
+  PLDVO_RELEASE_ONLY_ACCURACY_TEST("OdometryTest.DeterministicModeRepeatsExactly");
   const RunResult run = RunSequence(DeterministicConfig());
   ASSERT_EQ(run.frames.size(), static_cast<size_t>(kFrames));
   for (const OdometryFrameResult& frame : run.frames) {
@@ -334,6 +336,7 @@ TEST(OdometryTest, ReinitialisationWithThePropagatedMapKeepsOneScaleSegment) {
 // (0.72 unlit), no lost frame, worst transfer error 1.7 gray levels at the mean; without it
 // ATE 12.6 mm, RPE 3.93 cm/s, 3 lost events.
 TEST(OdometryTest, AffineBrightnessFollowsAGlobalGainAndBias) {
+  PLDVO_RELEASE_ONLY_ACCURACY_TEST("TrackerTest.AffineBrightnessRecoversPoseGainAndBias");
   std::vector<FrameLighting> lighting(kFrames);
   for (int i = 0; i < kFrames; ++i) {
     lighting[i].gain = 1.0 + 0.2 * std::sin(2.0 * M_PI * i / 12.0);

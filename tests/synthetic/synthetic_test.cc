@@ -20,6 +20,7 @@
 
 #include "core/statistics.h"
 #include "experiments/synthetic/synthetic_sequence.h"
+#include "tests/sanitizer_budget.h"
 
 namespace pldvo::synthetic {
 namespace {
@@ -363,6 +364,7 @@ constexpr int kRenderEvery = 10;
 #endif
 
 TEST(SyntheticTest, TrajectoryStaysInsideTheRoomAndSeesStructure) {
+  PLDVO_RELEASE_ONLY_ACCURACY_TEST("SyntheticTest.RenderingIsDeterministic");
   for (const std::string preset : {"lowtex", "fast"}) {
     for (int seed : {1, 2, 3}) {
       SynthOptions options = SmallOptions(preset, 160, 120);
