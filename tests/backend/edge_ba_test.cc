@@ -248,7 +248,7 @@ TEST(EdgeBATest, JacobianHasFullRankAtSolution) {
       for (int i = crs.rows[r]; i < crs.rows[r + 1]; ++i) dense(r, crs.cols[i]) = crs.values[i];
     }
     EXPECT_EQ(crs.num_cols, problem.NumVariableTangentParameters());
-    return Eigen::BDCSVD<Eigen::MatrixXd>(dense).singularValues().eval();
+    return Eigen::JacobiSVD<Eigen::MatrixXd>(dense).singularValues().eval();
   };
   auto rank = [](const Eigen::VectorXd& sv) {
     int r = 0;
