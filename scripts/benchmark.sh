@@ -14,10 +14,12 @@
 #   PLDVO_BENCH_FILTER   extended regex: only the sequences whose name matches (e.g.
 #                        '^(lowtex|boxes)_s1$'); default all
 #   PLDVO_BENCH_JOBS     runs in parallel (default 2)
+#   PLDVO_BENCH_SET      extra `--set key=value` arguments for every run (default none; e.g.
+#                        '--set odometry.inline_mapping_lag=3', the mapping thread's schedule)
 #   PLDVO_TUM_RPY, PLDVO_KITTI  the real sequences (default ../shared/data/tum_fr1_rpy and
 #                        ../shared/data/kitti00_first200 relative to the repository; skipped with
 #                        a message when absent)
-# Sequences are rendered into OUT/seq_f<frames>/ and kept; runs already in OUT are kept (pldvo
+# Sequences (scripts/dev_set.sh) are rendered into OUT/seq_f<frames>/ and kept; runs already in OUT are kept (pldvo
 # ablate --skip_existing), so an interrupted benchmark resumes. The runs map inline
 # (odometry.parallel_mapping=false): the spread is the initial map's, not the thread timing's.
 # The full set (11 families x 3 seeds + 2 real, x 2 configs x 8 maps, 300 frames) is about 560
@@ -29,8 +31,6 @@ if [ $# -ne 1 ]; then
 fi
 repo=$(cd "$(dirname "$0")/.." && pwd)
 out=$(realpath -m "$1")
-tum=$(realpath -m "${PLDVO_TUM_RPY:-$repo/../shared/data/tum_fr1_rpy}")
-kitti=$(realpath -m "${PLDVO_KITTI:-$repo/../shared/data/kitti00_first200}")
 repeats=${PLDVO_BENCH_REPEATS:-8}
 frames=${PLDVO_BENCH_FRAMES:-300}
 seeds=${PLDVO_BENCH_SEEDS:-1 2 3}
@@ -42,49 +42,10 @@ pldvo="$build/experiments/pldvo"
 [ -x "$pldvo" ] || scripts/build.sh >/dev/null
 configs=experiments/configs
 
-# family name -> pldvo synth arguments. Names avoid dots: ablate names a sequence by its folder.
-families=(
-  "lowtex|--preset lowtex"
-  "textured|--preset textured"
-  "contrast050|--preset lowtex --set contrast=0.5"
-  "contrast075|--preset lowtex --set contrast=0.75"
-  "contrast125|--preset lowtex --set contrast=1.25"
-  "brightp20|--preset lowtex --set brightness=0.2"
-  "brightm20|--preset lowtex --set brightness=-0.2"
-  "autoexposure|--preset autoexposure"
-  "checkerboard|--preset checkerboard"
-  "boxes|--preset boxes"
-  "handheld|--preset handheld"
-)
-seq_dir="$out/seq_f$frames"
-mkdir -p "$seq_dir"
-datasets=()
-for entry in "${families[@]}"; do
-  family=${entry%%|*}
-  # shellcheck disable=SC2206
-  args=(${entry#*|})
-  for seed in $seeds; do
-    name="${family}_s$seed"
-    echo "$name" | grep -Eq -- "$filter" || continue
-    if [ ! -f "$seq_dir/$name/rgb.txt" ]; then
-      echo "benchmark: rendering $name ($frames frames)"
-      rm -rf "$seq_dir/$name.partial"
-      "$pldvo" synth "${args[@]}" --seed "$seed" --frames "$frames" --threads "$jobs" \
-        --out "$seq_dir/$name.partial" >/dev/null
-      mv "$seq_dir/$name.partial" "$seq_dir/$name"
-    fi
-    datasets+=("$seq_dir/$name")
-  done
-done
-for real in "$tum" "$kitti"; do
-  name=$(basename "$real")
-  echo "$name" | grep -Eq -- "$filter" || continue
-  if [ -f "$real/rgb.txt" ]; then
-    datasets+=("$real")
-  else
-    echo "benchmark: skipping $name: no $real/rgb.txt"
-  fi
-done
+source scripts/dev_set.sh
+mapfile -t datasets < <(dev_set_datasets "$pldvo" "$out/seq_f$frames" "$frames" "$seeds" "$filter" \
+  "$jobs")
+wait $! || { echo "benchmark: rendering the development set failed" >&2; exit 1; }
 if [ ${#datasets[@]} -eq 0 ]; then
   echo "benchmark: no sequence matches PLDVO_BENCH_FILTER='$filter'" >&2
   exit 2
@@ -93,9 +54,11 @@ fi
 ablation="$out/ablation_f${frames}_r$repeats"
 list=$(IFS=,; echo "${datasets[*]}")
 echo "benchmark: ${#datasets[@]} sequences x 2 configs x $repeats initial maps -> $ablation"
+# shellcheck disable=SC2086  # PLDVO_BENCH_SET is a list of arguments
 "$pldvo" ablate --configs "$configs/sdvo.yaml,$configs/points_lines.yaml" --datasets "$list" \
   --repeats "$repeats" --jobs "$jobs" --skip_existing --run_max_frames "$frames" \
-  --set odometry.parallel_mapping=false --out "$ablation" >"$ablation.log" 2>&1 ||
+  --set odometry.parallel_mapping=false ${PLDVO_BENCH_SET:-} --out "$ablation" \
+  >"$ablation.log" 2>&1 ||
   echo "benchmark: a run failed (see $ablation/results.md and the runs' log.txt)"
 
 # The table: results.csv's columns by name (new columns are appended there), only the

@@ -1,15 +1,18 @@
 #!/usr/bin/env bash
 # The deviation table (docs/deviations.md): paper.yaml (the method as published), points_lines.yaml
 # (the default), paper.yaml with each extra of this implementation switched on alone and
-# points_lines.yaml with each switched off alone, all through one `pldvo ablate` grid over the
-# development sequences, then the page with each extra, why it exists and its measured effect on
-# RPE, lost events and time (medians over sequences x initial maps).
+# points_lines.yaml with each switched off alone, all through one `pldvo ablate` grid, then the
+# page with each extra, why it exists and its measured effect on RPE, lost events and time.
 #
-# Defaults are a SMALL set for a shared 2-core machine: the lowtex and textured presets, 150
-# frames at 320x240 (focal length scaled: the field of view of 640x480), 3 initial maps
-# (mapping.init_seed 1..3), inline mapping (deterministic).
-# Larger: PLDVO_DEV_FRAMES=300 PLDVO_DEV_WIDTH=640 PLDVO_DEV_HEIGHT=480 PLDVO_DEV_REPEATS=5, or the
-# cluster (docs/cluster.md: the grid's configs are in $dir/configs after the first step).
+# PLDVO_DEV_SET=small (default, for a shared 2-core machine): the lowtex and textured presets
+# (PLDVO_DEV_PRESETS), 150 frames at 320x240 (focal length scaled: the field of view of 640x480).
+# PLDVO_DEV_SET=full: the development set of scripts/benchmark.sh (scripts/dev_set.sh: every
+# synthetic family at PLDVO_DEV_SEEDS, default "1 2 3", 640x480, and fr1/rpy and KITTI 00 when
+# present), PLDVO_DEV_FRAMES frames (default 300), PLDVO_DEV_FILTER an extended regex on the
+# sequence names. Both: PLDVO_DEV_REPEATS initial maps (default 3; mapping.init_seed 1..R),
+# inline mapping (deterministic), PLDVO_DEV_JOBS runs at a time. The full set is 32 configs x 35
+# sequences x R maps: a cluster job (docs/cluster.md; the grid's configs are in $dir/configs after
+# the first step).
 # Needs python3 with PyYAML (Debian: python3-yaml, which scripts/install_deps.sh installs) to
 # write the config variants.
 set -euo pipefail
@@ -17,26 +20,48 @@ cd "$(dirname "$0")/.."
 build=${PLDVO_BUILD_DIR:-build}
 pldvo=${PLDVO:-$build/experiments/pldvo}
 dir=${PLDVO_DEV_DIR:-/tmp/pldvo_deviations}
-frames=${PLDVO_DEV_FRAMES:-150}
-width=${PLDVO_DEV_WIDTH:-320}
-height=${PLDVO_DEV_HEIGHT:-240}
+set_name=${PLDVO_DEV_SET:-small}
 repeats=${PLDVO_DEV_REPEATS:-3}
 jobs=${PLDVO_DEV_JOBS:-$(nproc)}
-presets=${PLDVO_DEV_PRESETS:-lowtex textured}
-# The synthetic camera's 525 px focal length is for 640x480; scaled with the width, so that every
-# size sees the same 63 deg field of view (as the tests' 320x240 sequence, f = 262.5).
-focal=$(python3 -c "print(525.0 * $width / 640)")
 [ -x "$pldvo" ] || { echo "deviations.sh: build $pldvo first (scripts/build.sh)" >&2; exit 1; }
 mkdir -p "$dir/configs"
 datasets=()
-for preset in $presets; do
-  seq="$dir/${preset}_${frames}_${width}x${height}"
-  if [ ! -f "$seq/rgb.txt" ]; then
-    "$pldvo" synth --preset "$preset" --frames "$frames" --width "$width" --height "$height" \
-      --set "fx=$focal" --set "fy=$focal" --out "$seq"
-  fi
-  datasets+=("$seq")
-done
+case "$set_name" in
+  small)
+    frames=${PLDVO_DEV_FRAMES:-150}
+    width=${PLDVO_DEV_WIDTH:-320}
+    height=${PLDVO_DEV_HEIGHT:-240}
+    presets=${PLDVO_DEV_PRESETS:-lowtex textured}
+    # The synthetic camera's 525 px focal length is for 640x480; scaled with the width, so that
+    # every size sees the same 63 deg field of view (as the tests' 320x240 sequence, f = 262.5).
+    focal=$(python3 -c "print(525.0 * $width / 640)")
+    for preset in $presets; do
+      seq="$dir/${preset}_${frames}_${width}x${height}"
+      if [ ! -f "$seq/rgb.txt" ]; then
+        "$pldvo" synth --preset "$preset" --frames "$frames" --width "$width" --height "$height" \
+          --set "fx=$focal" --set "fy=$focal" --out "$seq"
+      fi
+      datasets+=("$seq")
+    done
+    description="a SMALL set for a shared 2-core machine (indications, not results: rerun with \
+PLDVO_DEV_SET=full): the synthetic $(echo "$presets" | sed 's/ / and /g') presets, $frames frames \
+at ${width}x$height (f scaled: 63 deg field of view)"
+    ;;
+  full)
+    frames=${PLDVO_DEV_FRAMES:-300}
+    # shellcheck source=scripts/dev_set.sh
+    source scripts/dev_set.sh
+    mapfile -t datasets < <(dev_set_datasets "$pldvo" "$dir/seq_f$frames" "$frames" \
+      "${PLDVO_DEV_SEEDS:-1 2 3}" "${PLDVO_DEV_FILTER:-.}" "$jobs")
+    wait $! || { echo "deviations.sh: rendering the development set failed" >&2; exit 1; }
+    description="the development set (scripts/dev_set.sh: ${#datasets[@]} sequences), at most \
+$frames frames each"
+    ;;
+  *)
+    echo "deviations.sh: PLDVO_DEV_SET must be small or full, not '$set_name'" >&2
+    exit 2
+    ;;
+esac
 
 # The extras: name | keys=values as in points_lines (on) | as in paper.yaml (off) | why.
 cat > "$dir/deviations.tsv" <<'TSV'
@@ -90,28 +115,51 @@ while IFS=$'\t' read -r name _; do
 done < "$dir/deviations.tsv"
 (IFS=,; echo "deviations.sh: ${#datasets[@]} sequences x 32 configs x $repeats initial maps")
 "$pldvo" ablate --configs "$configs" --datasets "$(IFS=,; echo "${datasets[*]}")" \
-  --out "$dir/grid" --repeats "$repeats" --jobs "$jobs" --skip_existing \
+  --out "$dir/grid" --repeats "$repeats" --jobs "$jobs" --skip_existing --run_max_frames "$frames" \
   --set odometry.parallel_mapping=false > "$dir/ablate.log" || true
 
-python3 - "$dir" "$frames" "$width" "$height" "$repeats" "$presets" <<'PY'
-import csv, json, os, statistics, sys
-out, frames, width, height, repeats, presets = sys.argv[1:7]
+python3 - "$dir" "$repeats" "$description" <<'PY'
+import csv, os, re, statistics, sys
+out, repeats, description = sys.argv[1:4]
 rows = list(csv.DictReader(open(os.path.join(out, 'grid', 'results.csv'))))
-BAD_RPE = 10.0  # cm/s: a map that converged to a wrong structure (docs/odometry.md)
-def stats(config, dataset=None):
-    runs = [r for r in rows if r['config'] == config and dataset in (None, r['dataset'])]
-    ok = [r for r in runs if r['status'] == 'ok']
-    med = lambda key: statistics.median(float(r[key]) for r in ok) if ok else float('nan')
-    return {'runs': len(runs), 'failed': len(runs) - len(ok), 'rpe': med('rpe_cm_s'),
-            'bad': sum(float(r['rpe_cm_s']) > BAD_RPE for r in ok),
-            'lost': sum(int(r['lost_events'] or 0) for r in ok), 'ms': med('ms_median_tracking_thread')}
-def fmt(s):
+datasets = list(dict.fromkeys(r['dataset'] for r in rows))
+family = lambda d: re.sub(r'_s\d+$', '', d)
+families = list(dict.fromkeys(family(d) for d in datasets))
+def runs(config, dataset):
+    return [r for r in rows if r['config'] == config and r['dataset'] == dataset]
+def ok(config, dataset):
+    return [r for r in runs(config, dataset) if r['status'] == 'ok']
+def median(values):
+    return statistics.median(values) if values else float('nan')
+# A bad run: RPE above twice the median of paper.yaml's and points_lines.yaml's runs on its
+# sequence (a map that converged to a wrong structure, a scale collapse): scale-free, so KITTI's
+# 30 cm/s and a synthetic room's 3 cm/s are judged alike.
+reference = {d: median([float(r['rpe_cm_s']) for c in ('paper', 'points_lines') for r in ok(c, d)])
+             for d in datasets}
+def summary(config, names):
+    chosen = [r for d in names for r in runs(config, d)]
+    good = [r for r in chosen if r['status'] == 'ok']
+    return {'rpe': median([float(r['rpe_cm_s']) for r in good]), 'failed': len(chosen) - len(good),
+            'bad': sum(float(r['rpe_cm_s']) > 2 * reference[r['dataset']] for r in good),
+            'lost': sum(int(r['lost_events'] or 0) for r in good),
+            'ms': median([float(r['ms_median_tracking_thread']) for r in good])}
+def cell(s):
     x = ' (%d X)' % s['failed'] if s['failed'] else ''
     return '%.2f / %d / %d / %.0f%s' % (s['rpe'], s['bad'], s['lost'], s['ms'], x)
-def delta(s, ref):
-    return '%+.2f / %+d / %+d / %+.0f' % (s['rpe'] - ref['rpe'], s['bad'] - ref['bad'],
-                                         s['lost'] - ref['lost'], s['ms'] - ref['ms'])
-paper, pl = stats('paper'), stats('points_lines')
+def change(config, ref):
+    # Per sequence the ratio of the medians over the initial maps, then the median over sequences.
+    ratios, ms = [], []
+    for d in datasets:
+        a, b = ok(config, d), ok(ref, d)
+        if a and b:
+            ratios.append(median([float(r['rpe_cm_s']) for r in a]) /
+                          median([float(r['rpe_cm_s']) for r in b]))
+            ms.append(median([float(r['ms_median_tracking_thread']) for r in a]) /
+                      median([float(r['ms_median_tracking_thread']) for r in b]))
+    s, t = summary(config, datasets), summary(ref, datasets)
+    return '%.2f [%d / %d] / %+d / %+d / %.2f' % (
+        median(ratios), sum(x < 0.9 for x in ratios), sum(x > 1.1 for x in ratios),
+        s['bad'] - t['bad'], s['lost'] - t['lost'], median(ms))
 lines = []
 w = lines.append
 w('# Deviations from the paper')
@@ -122,38 +170,39 @@ w('exists, and its measured effect switched on alone in paper.yaml and switched 
 w('points_lines.yaml. Equation numbers are the paper\'s (eq. 1 E(xi), eq. 2 r_i, eq. 3 g_j,')
 w('eq. 5 Sigma_f, eq. 6 Sigma_g, eqs. 8-10 line-guided stereo, eqs. 11-13 line regularisation).')
 w('')
-w('Measured on a SMALL development set, chosen for a shared 2-core machine: the synthetic')
-w('%s presets, %s frames at %sx%s (f scaled: 63 deg field of view), %s' % (' and '.join(presets.split()), frames, width, height, repeats))
-w('initial maps each (mapping.init_seed 1..%s), inline mapping (deterministic). Each cell, over' % repeats)
-w('the %d runs of a config: median RPE (cm/s, Sim(3)-aligned, 1 s intervals) / runs with RPE' % (len(presets.split()) * int(repeats)))
-w('above %.0f cm/s (the monocular map converged to a wrong structure) / lost events / median' % BAD_RPE)
-w('tracking-thread ms per frame (mapping inline, included); X: failed runs. "change" is the')
-w('difference to paper.yaml (extra on) or points_lines.yaml (extra off). Whether the random')
-w('initial map converges dominates RPE on so few runs, so differences here are indications, not')
-w('results: rerun on the full set (larger frames, more sequences and seeds; the')
-w('`scripts/deviations.sh` header, docs/cluster.md).')
+w('Measured on %s, %s initial maps per sequence (mapping.init_seed 1..%s), inline mapping' % (description, repeats, repeats))
+w('(deterministic). A bad run has an RPE above twice the median of paper.yaml\'s and')
+w('points_lines.yaml\'s runs on its sequence (a map converged to a wrong structure, a collapsed')
+w('scale). First table, per sequence family: median RPE (cm/s, Sim(3)-aligned, 1 s intervals) /')
+w('bad runs / lost events / median tracking-thread ms per frame (mapping inline, included);')
+w('X: failed runs.')
 w('')
-w('Regenerate: `scripts/deviations.sh` (writes this page; the grid\'s results.csv/.md/.json in')
-w('`${PLDVO_DEV_DIR:-/tmp/pldvo_deviations}/grid`).')
+w('Regenerate: `scripts/deviations.sh` (`PLDVO_DEV_SET=full` for the development set; writes this')
+w('page; the grid\'s results.csv/.md/.json in `${PLDVO_DEV_DIR:-/tmp/pldvo_deviations}/grid`).')
 w('')
-w('| config | all runs | %s |' % ' | '.join(presets.split()))
-w('| --- | --- |%s' % (' --- |' * len(presets.split())))
-datasets = sorted({r['dataset'] for r in rows}, key=lambda d: [p in d for p in presets.split()].index(True) if any(p in d for p in presets.split()) else 0)
-for name in ('paper', 'points_lines'):
-    w('| %s.yaml | %s | %s |' % (name, fmt(stats(name)), ' | '.join(fmt(stats(name, d)) for d in datasets)))
+w('| family | paper.yaml | points_lines.yaml |')
+w('| --- | --- | --- |')
+for f in families:
+    names = [d for d in datasets if family(d) == f]
+    w('| %s | %s | %s |' % (f, cell(summary('paper', names)), cell(summary('points_lines', names))))
+w('| all | %s | %s |' % (cell(summary('paper', datasets)), cell(summary('points_lines', datasets))))
 w('')
-w('| extra | switch (on; paper.yaml value) | why | paper + extra | change | points_lines - extra | change |')
-w('| --- | --- | --- | --- | --- | --- | --- |')
+w('Second table, each change against its reference (paper.yaml for "paper + extra",')
+w('points_lines.yaml for "points_lines - extra"): the median over sequences of the RPE ratio (each')
+w('sequence\'s median over the initial maps) [sequences more than 10% better / worse] / change in')
+w('bad runs / change in lost events / median ratio of the tracking-thread time.')
+w('')
+w('| extra | switch (on; paper.yaml value) | why | paper + extra | points_lines - extra |')
+w('| --- | --- | --- | --- | --- |')
 for line in open(os.path.join(out, 'deviations.tsv')):
     name, on, off, why = line.rstrip('\n').split('\t')
-    plus, minus = stats('paper+' + name), stats('points_lines-' + name)
-    w('| %s | `%s` (`%s`) | %s | %s | %s | %s | %s |' % (
-        name, on.replace(';', '`, `'), off.split('=', 1)[1], why, fmt(plus), delta(plus, paper),
-        fmt(minus), delta(minus, pl)))
+    w('| %s | `%s` (`%s`) | %s | %s | %s |' % (
+        name, on.replace(';', '`, `'), off.split('=', 1)[1], why,
+        change('paper+' + name, 'paper'), change('points_lines-' + name, 'points_lines')))
 w('')
-w('Times come from a shared machine: a row whose RPE change is +0.00 with +0 bad runs most likely ran')
-w('the same trajectories as its reference (the switch never acted on these sequences), so its ms')
-w('change shows how much the time varies with the load alone.')
+w('Times come from a shared machine: a row with RPE ratio 1.00 [0 / 0] most likely ran the same')
+w('trajectories as its reference (the switch never acted on these sequences), so its time ratio')
+w('shows how much the time varies with the load alone.')
 w('')
 w('Not switched: differences of this implementation that the paper does not specify either way')
 w('(e.g. the half-pixel SSD search step, edge merging, the Huber loss threshold) keep their')
