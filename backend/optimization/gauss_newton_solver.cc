@@ -11,6 +11,77 @@
 #include "backend/optimization/normal_equations.h"
 
 namespace pldvo {
+namespace {
+
+// The tangent columns of the blocks to eliminate by Schur complement (sorted) and of the rest:
+// every variable block marked eliminated with tangent size 1, provided no residual block reads
+// two of them (then their part of H is diagonal). Empty `eliminated` otherwise: dense solve.
+void SchurPartition(const LeastSquaresProblem& problem, const NormalEquations& equations,
+                    std::vector<int>* eliminated, std::vector<int>* kept) {
+  eliminated->clear();
+  kept->clear();
+  const auto& blocks = problem.parameter_blocks();
+  std::vector<char> is_eliminated(blocks.size(), 0);
+  bool any = false;
+  for (size_t i = 0; i < blocks.size(); ++i) {
+    if (equations.TangentOffset(static_cast<int>(i)) < 0 || !blocks[i].eliminated) continue;
+    if (blocks[i].TangentSize() != 1) return;
+    is_eliminated[i] = 1;
+    any = true;
+  }
+  if (!any) return;
+  for (const LeastSquaresProblem::ResidualBlock& block : problem.residual_blocks()) {
+    int count = 0;
+    for (const int index : block.parameter_block_indices) count += is_eliminated[index];
+    if (count > 1) return;
+  }
+  for (size_t i = 0; i < blocks.size(); ++i) {
+    const int offset = equations.TangentOffset(static_cast<int>(i));
+    if (offset < 0) continue;
+    for (int c = 0; c < blocks[i].TangentSize(); ++c) {
+      (is_eliminated[i] ? eliminated : kept)->push_back(offset + c);
+    }
+  }
+  std::sort(eliminated->begin(), eliminated->end());
+  std::sort(kept->begin(), kept->end());
+}
+
+// (H + lambda diag(H)) delta = -g with the eliminated columns P (diagonal H_PP) removed first:
+//   S = H_KK - H_KP D^-1 H_PK,  S delta_K = -g_K + H_KP D^-1 g_P,
+//   delta_P = D^-1 (-g_P - H_PK delta_K),
+// D = (1 + lambda) diag(H_PP), K the kept columns (the same damping on S's diagonal). A column
+// without information (D = 0, hence H_PK = 0 too) gets delta 0. Returns false when S is not
+// factorisable.
+bool SolveSchur(const Eigen::MatrixXd& hessian, const Eigen::VectorXd& gradient, double lambda,
+                const std::vector<int>& eliminated, const std::vector<int>& kept,
+                Eigen::LDLT<Eigen::MatrixXd>* ldlt, Eigen::VectorXd* delta) {
+  const int num_eliminated = static_cast<int>(eliminated.size());
+  Eigen::VectorXd d_inverse(num_eliminated);
+  Eigen::VectorXd g_eliminated(num_eliminated);
+  for (int i = 0; i < num_eliminated; ++i) {
+    const double d = (1.0 + lambda) * hessian(eliminated[i], eliminated[i]);
+    d_inverse[i] = d > 0.0 ? 1.0 / d : 0.0;
+    g_eliminated[i] = gradient[eliminated[i]];
+  }
+  const Eigen::MatrixXd h_kp = hessian(kept, eliminated);
+  const Eigen::VectorXd g_kept = gradient(kept);
+  Eigen::VectorXd delta_kept = Eigen::VectorXd::Zero(static_cast<int>(kept.size()));
+  if (!kept.empty()) {
+    Eigen::MatrixXd schur = hessian(kept, kept);
+    if (lambda > 0.0) schur.diagonal() *= 1.0 + lambda;
+    schur.noalias() -= h_kp * d_inverse.asDiagonal() * h_kp.transpose();
+    ldlt->compute(schur);
+    if (ldlt->info() != Eigen::Success) return false;
+    delta_kept = ldlt->solve(-g_kept + h_kp * d_inverse.cwiseProduct(g_eliminated));
+  }
+  const Eigen::VectorXd delta_eliminated =
+      d_inverse.cwiseProduct(-g_eliminated - h_kp.transpose() * delta_kept);
+  for (size_t i = 0; i < kept.size(); ++i) (*delta)[kept[i]] = delta_kept[i];
+  for (int i = 0; i < num_eliminated; ++i) (*delta)[eliminated[i]] = delta_eliminated[i];
+  return delta->allFinite();
+}
+
+}  // namespace
 
 SolverSummary GaussNewtonSolver::Solve(LeastSquaresProblem* problem,
                                        const SolverIterationCallback& callback) const {
@@ -42,7 +113,11 @@ SolverSummary GaussNewtonSolver::Solve(LeastSquaresProblem* problem,
   if (callback) callback({0, cost, true});
 
   const int n = equations->dimension();
-  Eigen::MatrixXd damped(n, n);
+  // Blocks marked eliminated (LeastSquaresProblem::SetParameterBlockEliminated) are removed by
+  // Schur complement when that is exact; otherwise the dense system is solved.
+  std::vector<int> eliminated, kept;
+  SchurPartition(*problem, *equations, &eliminated, &kept);
+  Eigen::MatrixXd damped(eliminated.empty() ? n : 0, eliminated.empty() ? n : 0);
   Eigen::VectorXd delta(n);
   std::vector<double> backup;
   Eigen::LDLT<Eigen::MatrixXd> ldlt(n);
@@ -57,13 +132,19 @@ SolverSummary GaussNewtonSolver::Solve(LeastSquaresProblem* problem,
   summary.message = "iteration limit reached";
   while (summary.iterations < options_.max_iterations) {
     ++summary.iterations;
-    damped = equations->hessian();
-    if (lambda > 0.0) damped.diagonal() += lambda * equations->hessian().diagonal();
-    ldlt.compute(damped);
-    bool step_ok = ldlt.info() == Eigen::Success;
-    if (step_ok) {
-      delta = ldlt.solve(-equations->gradient());
-      step_ok = delta.allFinite();
+    bool step_ok = false;
+    if (!eliminated.empty()) {
+      step_ok = SolveSchur(equations->hessian(), equations->gradient(), lambda, eliminated, kept,
+                           &ldlt, &delta);
+    } else {
+      damped = equations->hessian();
+      if (lambda > 0.0) damped.diagonal() += lambda * equations->hessian().diagonal();
+      ldlt.compute(damped);
+      step_ok = ldlt.info() == Eigen::Success;
+      if (step_ok) {
+        delta = ldlt.solve(-equations->gradient());
+        step_ok = delta.allFinite();
+      }
     }
     double new_cost = cost;
     bool accepted = false;

@@ -17,6 +17,10 @@
 // Tangent-space Jacobians are the cost functions' ambient Jacobians times
 // Manifold::PlusJacobian(x). The normal equations are dense (intended for small problems such
 // as a 6-DOF pose); accumulation uses buffers sized once per solve, no per-residual allocation.
+// Blocks marked eliminated (LeastSquaresProblem::SetParameterBlockEliminated: 1-D blocks no two
+// of which share a residual block, such as the inverse depths of bundle adjustment) are removed
+// by the Schur complement S = H_KK - H_KP H_PP^-1 H_PK before the LDLT, which then factorises
+// only the kept (pose, brightness) part; the step is the dense one, to rounding.
 // Step acceptance and stopping: see SolverOptions. A trial step after an accepted one is
 // linearised in full, so a run of accepted steps evaluates the cost functions once per step
 // (Ceres' LM: twice, cost then Jacobians); after a rejection only the cost is evaluated.

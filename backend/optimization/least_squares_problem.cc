@@ -55,6 +55,23 @@ void LeastSquaresProblem::SetParameterBlockVariable(const double* values) {
   parameter_blocks_[index].constant = false;
 }
 
+void LeastSquaresProblem::SetParameterBlockEliminated(const double* values) {
+  const int index = ParameterBlockIndex(values);
+  if (index < 0) {
+    throw std::invalid_argument(std::string(__FILE__) + ":" + std::to_string(__LINE__) +
+                                ": unknown parameter block");
+  }
+  parameter_blocks_[index].eliminated = true;
+}
+
+std::vector<double*> LeastSquaresProblem::EliminatedBlocks() const {
+  std::vector<double*> blocks;
+  for (const ParameterBlock& block : parameter_blocks_) {
+    if (block.eliminated) blocks.push_back(block.values);
+  }
+  return blocks;
+}
+
 ceres::LossFunction* LeastSquaresProblem::AddLossFunction(
     std::unique_ptr<ceres::LossFunction> loss_function) {
   owned_loss_functions_.push_back(std::move(loss_function));

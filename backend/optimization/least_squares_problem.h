@@ -30,6 +30,8 @@ class LeastSquaresProblem {
     int size = 0;                         // ambient size
     ceres::Manifold* manifold = nullptr;  // nullptr: Euclidean
     bool constant = false;
+    // Eliminated first in a Schur-complement solve (SetParameterBlockEliminated).
+    bool eliminated = false;
     int TangentSize() const { return manifold != nullptr ? manifold->TangentSize() : size; }
   };
   struct ResidualBlock {
@@ -51,6 +53,14 @@ class LeastSquaresProblem {
                         std::unique_ptr<ceres::Manifold> manifold = nullptr);
   void SetParameterBlockConstant(const double* values);
   void SetParameterBlockVariable(const double* values);
+  // Marks a block to be eliminated first when the solver forms the Schur complement: a point's
+  // inverse depth in bundle adjustment, whose normal-equation block is diagonal. The
+  // Gauss-Newton solver eliminates marked blocks when each has tangent size 1 and no residual
+  // block reads two of them (and solves densely otherwise); a Ceres Schur ordering can be
+  // made from EliminatedBlocks(). It changes the linear algebra, never the objective.
+  void SetParameterBlockEliminated(const double* values);
+  // The parameter arrays of the blocks marked eliminated, in the order they were added.
+  std::vector<double*> EliminatedBlocks() const;
 
   // Takes ownership of a loss function and returns it, so that residual blocks (or cost
   // functions that robustify row-wise inside) can share it for the problem's lifetime.

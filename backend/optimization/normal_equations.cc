@@ -28,6 +28,7 @@ NormalEquations::NormalEquations(const LeastSquaresProblem& problem) : problem_(
   }
   residuals_.resize(max_rows);
   row_.resize(dimension_);
+  columns_.reserve(dimension_);
   jacobian_pointers_.resize(blocks.size());
   hessian_.resize(dimension_, dimension_);
   gradient_.resize(dimension_);
@@ -120,9 +121,21 @@ bool NormalEquations::Linearize(double* cost) {
       continue;
     }
 
-    // Accumulate the upper triangle of H and g row by row through a dense tangent row.
+    // Accumulate the upper triangle of H and g row by row through a dense tangent row, visiting
+    // only the columns of this block's variable parameter blocks (sorted, so that every entry
+    // receives the same sums in the same order as a sweep over all columns would give it).
+    columns_.clear();
+    for (int k = 0; k < num_blocks; ++k) {
+      const int index = block.parameter_block_indices[k];
+      const int offset = tangent_offset_[index];
+      if (offset < 0) continue;
+      const int tangent = problem_.parameter_blocks()[index].TangentSize();
+      for (int c = 0; c < tangent; ++c) columns_.push_back(offset + c);
+    }
+    std::sort(columns_.begin(), columns_.end());
+    const int num_columns = static_cast<int>(columns_.size());
     for (int r = 0; r < rows; ++r) {
-      std::fill(row_.begin(), row_.end(), 0.0);
+      for (const int column : columns_) row_[column] = 0.0;
       for (int k = 0; k < num_blocks; ++k) {
         const int index = block.parameter_block_indices[k];
         const int offset = tangent_offset_[index];
@@ -132,11 +145,12 @@ bool NormalEquations::Linearize(double* cost) {
         for (int c = 0; c < tangent; ++c) row_[offset + c] += jacobian_scaling * jac_row[c];
       }
       const double residual = residual_scaling * residuals_[r];
-      for (int a = 0; a < dimension_; ++a) {
+      for (int i = 0; i < num_columns; ++i) {
+        const int a = columns_[i];
         const double ja = row_[a];
         if (ja == 0.0) continue;
         gradient_[a] += ja * residual;
-        for (int b = a; b < dimension_; ++b) hessian_(a, b) += ja * row_[b];
+        for (int j = i; j < num_columns; ++j) hessian_(a, columns_[j]) += ja * row_[columns_[j]];
       }
     }
   }

@@ -40,6 +40,7 @@ class NormalEquations {
   std::vector<std::vector<double>> tangent_jacobian_;
   std::vector<double> residuals_;
   std::vector<double> row_;
+  std::vector<int> columns_;  // tangent columns of one residual block's variable blocks, sorted
   std::vector<double> ambient_scratch_;
   std::vector<double*> jacobian_pointers_;
   Eigen::MatrixXd hessian_;
