@@ -77,6 +77,7 @@ class HostTargetPhotometricResidual : public ceres::CostFunction {
                 double** jacobians) const override;
 
   int num_pixels() const { return static_cast<int>(pattern_.size()); }
+  const std::vector<HostPixel>& pattern() const { return pattern_; }
 
  private:
   using IntensityGrid = ceres::Grid2D<float, 1>;

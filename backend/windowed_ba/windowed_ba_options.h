@@ -1,0 +1,133 @@
+// Options of windowed photometric + line bundle adjustment (docs/windowed_ba.md). One typed
+// struct: read from YAML and `--set` through VisitFields (core/config_io.h, unknown keys are
+// errors), validated by Check(). Not yet a section of the odometry's config: the BA does not run
+// in the odometry loop yet (docs/windowed_ba.md, "Not done yet").
+#ifndef PLDVO_BACKEND_WINDOWED_BA_WINDOWED_BA_OPTIONS_H_
+#define PLDVO_BACKEND_WINDOWED_BA_WINDOWED_BA_OPTIONS_H_
+
+#include <string>
+
+#include "core/options.h"
+#include "residuals/affine_brightness.h"
+#include "residuals/photometric_residual.h"
+#include "residuals/weighting.h"
+
+namespace pldvo {
+
+// The host pixels of one point's photometric residual (sharing its inverse depth).
+enum class WindowedBAPattern {
+  kSingle,  // the point's pixel only
+  kDso8,    // DSO's 8-pixel pattern (offsets within 2 px), more rows per inverse depth
+};
+inline const ChoiceNames<WindowedBAPattern>& WindowedBAPatternNames() {
+  static const ChoiceNames<WindowedBAPattern> names = {{"single", WindowedBAPattern::kSingle},
+                                                       {"dso8", WindowedBAPattern::kDso8}};
+  return names;
+}
+
+enum class WindowedBASolver { kCeres, kGaussNewton };
+inline const ChoiceNames<WindowedBASolver>& WindowedBASolverNames() {
+  static const ChoiceNames<WindowedBASolver> names = {
+      {"ceres", WindowedBASolver::kCeres}, {"gauss_newton", WindowedBASolver::kGaussNewton}};
+  return names;
+}
+
+enum class WindowedBALinearSolver { kSparseSchur, kDenseSchur, kSparseNormalCholesky };
+inline const ChoiceNames<WindowedBALinearSolver>& WindowedBALinearSolverNames() {
+  static const ChoiceNames<WindowedBALinearSolver> names = {
+      {"sparse_schur", WindowedBALinearSolver::kSparseSchur},
+      {"dense_schur", WindowedBALinearSolver::kDenseSchur},
+      {"sparse_normal_cholesky", WindowedBALinearSolver::kSparseNormalCholesky}};
+  return names;
+}
+
+struct WindowedBAOptions {
+  // The registered problem builder (WindowedBAProblemBuilderRegistry): "windowed_ba" (robust
+  // loss row-wise inside the cost functions) or "windowed_ba_ceres_loss" (the loss given to the
+  // problem per residual block, i.e. per point pattern and target).
+  std::string problem_builder = "windowed_ba";
+  // The newest `window` keyframes of a window are optimised (>= 2). 5: the middle of the
+  // issue's 5-7, to be measured in the odometry.
+  int window = 5;
+  // Points per window (DSO: ~2000), split evenly over the keyframes; each keyframe's share is
+  // chosen by SelectWindowPoints (a grid of cells, best gradient per cell).
+  int max_points = 2000;
+  // Candidates whose image gradient magnitude is below this (gray levels / px) are not
+  // selected: their photometric rows hardly constrain anything.
+  double min_gradient = 5.0;
+  WindowedBAPattern pattern = WindowedBAPattern::kDso8;
+  // A point enters only if it has photometric rows in at least this many other keyframes.
+  int min_targets = 1;
+  // Sampling of the target images (residuals/photometric_residual.h): bilinear (as tracking) or
+  // bicubic (exact Jacobian).
+  ImageInterpolation interpolation = ImageInterpolation::kBilinear;
+  // affine: each keyframe's {a, b} (I = e^a L + b) is estimated, the oldest held constant (the
+  // brightness gauge), the others with a prior N(input, sigma^2): +-10% and +-10 gray levels,
+  // as tracking's prior. none: {a, b} held at their input values.
+  BrightnessModel brightness = BrightnessModel::kAffine;
+  double brightness_prior_sigma_a = 0.1;
+  double brightness_prior_sigma_b = 10.0;
+  // A weak prior N(input idepth, (idepth_prior_scale^2) V) on each point's inverse depth, V the
+  // depth filter's variance: it regularises the depth of a point whose rows hardly constrain
+  // it (image gradient across its epipolar lines, or one short-baseline target), along which
+  // the solvers otherwise crawl. Weak (10 sigma) because the priors also fix the scale at the
+  // inputs' depths, which fights the baseline prior's when the input poses and depths disagree
+  // in scale (measured in docs/windowed_ba.md). 0: no prior (DSO's choice).
+  double idepth_prior_scale = 10.0;
+  // Point-to-line rows (eq. 3) for selected points on edges with a line observation in another
+  // window keyframe (off: photometric only).
+  bool lines = true;
+  // sigma_b of the baseline prior (the scale gauge) as a fraction of the baseline. Any value > 0
+  // gives the same optimum (the data are scale-invariant); 1e-2 keeps the system conditioned.
+  double baseline_prior_sigma_ratio = 1e-2;
+  // Weighting (eq. 5, eq. 6 covariance models; sigma_I; robust loss and its threshold).
+  WeightingOptions weighting;
+  // Solver of the built problem: ceres (Levenberg-Marquardt, linear_solver below, inverse
+  // depths eliminated first) or gauss_newton (backend/optimization, Schur on the inverse depths).
+  WindowedBASolver solver = WindowedBASolver::kCeres;
+  WindowedBALinearSolver linear_solver = WindowedBALinearSolver::kSparseSchur;
+  int max_iterations = 20;
+  double function_tolerance = 1e-6;
+  int num_threads = 1;
+
+  template <class Visitor>
+  void VisitFields(Visitor& v) {
+    v.Field("problem_builder", &problem_builder,
+            "Registered windowed BA problem builder: windowed_ba (row-wise loss) or "
+            "windowed_ba_ceres_loss (loss per residual block).");
+    v.Field("window", &window, "Newest keyframes optimised (>= 2).");
+    v.Field("max_points", &max_points, "Points per window (split over the keyframes).");
+    v.Field("min_gradient", &min_gradient, "Smallest gradient magnitude of a selected point.");
+    v.Choice("pattern", &pattern, WindowedBAPatternNames(),
+             "Host pixels per point: single or dso8.");
+    v.Field("min_targets", &min_targets, "Other keyframes a point must reproject into (>= 1).");
+    v.Choice("interpolation", &interpolation, ImageInterpolationNames(),
+             "Sampling of the target images: bilinear or bicubic.");
+    v.Choice("brightness", &brightness, BrightnessModelNames(),
+             "Per-keyframe affine brightness estimated (affine) or held (none).");
+    v.Field("brightness_prior_sigma_a", &brightness_prior_sigma_a,
+            "Standard deviation of the prior on each keyframe's log-gain a.");
+    v.Field("brightness_prior_sigma_b", &brightness_prior_sigma_b,
+            "Standard deviation of the prior on each keyframe's bias b, gray levels.");
+    v.Field("idepth_prior_scale", &idepth_prior_scale,
+            "Prior on each inverse depth: N(input, (scale^2) V), V the depth filter's variance; "
+            "0 = none.");
+    v.Field("lines", &lines, "Point-to-line rows for points on edges with a line observation.");
+    v.Field("baseline_prior_sigma_ratio", &baseline_prior_sigma_ratio,
+            "sigma of the scale prior as a fraction of the baseline.");
+    v.Section("weighting", &weighting, "Weighting of the residual families and robust loss.");
+    v.Choice("solver", &solver, WindowedBASolverNames(), "ceres or gauss_newton.");
+    v.Choice("linear_solver", &linear_solver, WindowedBALinearSolverNames(),
+             "Ceres linear solver: sparse_schur, dense_schur, sparse_normal_cholesky.");
+    v.Field("max_iterations", &max_iterations, "Iterations per window.");
+    v.Field("function_tolerance", &function_tolerance, "Relative cost-change tolerance.");
+    v.Field("num_threads", &num_threads, "Ceres threads per solve.");
+  }
+  // "" when valid, otherwise what is wrong (names the key; an unknown problem_builder lists the
+  // registered ones).
+  std::string Check() const;
+};
+
+}  // namespace pldvo
+
+#endif  // PLDVO_BACKEND_WINDOWED_BA_WINDOWED_BA_OPTIONS_H_

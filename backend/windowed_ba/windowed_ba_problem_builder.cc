@@ -1,0 +1,291 @@
+#include "backend/windowed_ba/windowed_ba_problem_builder.h"
+
+#include <ceres/normal_prior.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include "backend/optimization/problem_builder_registry.h"
+#include "backend/windowed_ba/point_selection.h"
+#include "residuals/baseline_prior_residual.h"
+#include "residuals/host_target_photometric_residual.h"
+#include "residuals/host_target_point_to_line_residual.h"
+#include "residuals/se3_manifold.h"
+
+namespace pldvo {
+namespace {
+
+std::string Where(int line) { return std::string(__FILE__) + ":" + std::to_string(line) + ": "; }
+
+// DSO's residual pattern 8 (offsets within 2 px of the point).
+constexpr double kDso8Pattern[8][2] = {{0, -2}, {-1, -1}, {1, -1}, {-2, 0},
+                                       {0, 0},  {2, 0},   {-1, 1}, {0, 2}};
+
+// The builder of both registry entries; `loss_in_problem` chooses where the robust loss goes.
+class PhotometricLineWindowBuilder : public WindowedBAProblemBuilder {
+ public:
+  PhotometricLineWindowBuilder(const WindowedBAOptions& options, bool loss_in_problem)
+      : options_(options), loss_in_problem_(loss_in_problem) {
+    const std::string error = options_.Check();
+    if (!error.empty()) throw std::invalid_argument(Where(__LINE__) + error);
+  }
+
+  WindowedBAProblem Build(const WindowedBAWindow& window) const override;
+
+ private:
+  // Holds the scale: the baseline prior of the header, or the second pose constant.
+  void AddScaleGauge(WindowedBAProblem* problem) const;
+
+  WindowedBAOptions options_;
+  bool loss_in_problem_;
+};
+
+Eigen::Vector3d Centre(const double* cam_from_world) {
+  return PoseFromParameters(cam_from_world).Inverse().translation();
+}
+
+void PhotometricLineWindowBuilder::AddScaleGauge(WindowedBAProblem* out) const {
+  const int n = static_cast<int>(out->poses.size());
+  const Eigen::Vector3d oldest = Centre(out->poses[0].data());
+  double largest = 0.0;
+  int farthest = 1;
+  for (int k = 1; k < n; ++k) {
+    const double baseline = (Centre(out->poses[k].data()) - oldest).norm();
+    if (baseline > largest) {
+      largest = baseline;
+      farthest = k;
+    }
+  }
+  if (!(largest > 0.0)) {
+    out->problem.SetParameterBlockConstant(out->poses[1].data());
+    return;
+  }
+  const double next = (Centre(out->poses[1].data()) - oldest).norm();
+  const int partner = next >= 1e-3 * largest ? 1 : farthest;
+  out->baseline_keyframe_a = 0;
+  out->baseline_keyframe_b = partner;
+  out->baseline = partner == 1 ? next : largest;
+  out->problem.AddResidualBlock(
+      std::unique_ptr<ceres::CostFunction>(BaselinePriorResidual::Create(
+          out->baseline, options_.baseline_prior_sigma_ratio * out->baseline)),
+      nullptr, {out->poses[0].data(), out->poses[partner].data()});
+}
+
+WindowedBAProblem PhotometricLineWindowBuilder::Build(const WindowedBAWindow& window) const {
+  CheckWindowedBAWindow(window);
+  const PinholeCamera& camera = window.camera;
+  const int total = static_cast<int>(window.keyframes.size());
+  const int n = std::min(options_.window, total);
+  WindowedBAProblem out;
+  for (int k = total - n; k < total; ++k) out.keyframe_indices.push_back(k);
+  auto keyframe = [&](int position) -> const WindowedBAKeyframe& {
+    return window.keyframes[out.keyframe_indices[position]];
+  };
+  out.poses.resize(n);
+  out.brightness.resize(n);
+  for (int k = 0; k < n; ++k) {
+    PoseToParameters(keyframe(k).cam_from_world, out.poses[k].data());
+    out.brightness[k] = {keyframe(k).brightness.a, keyframe(k).brightness.b};
+  }
+
+  // Point selection, before any block is added: `idepths` must not reallocate afterwards.
+  const bool dso8 = options_.pattern == WindowedBAPattern::kDso8;
+  const double pattern_radius = dso8 ? 2.0 : 0.0;
+  const int budget = options_.max_points / n;
+  for (int k = 0; k < n; ++k) {
+    for (const int index : SelectWindowPoints(keyframe(k).points, *keyframe(k).pyramid, budget,
+                                              options_.min_gradient, pattern_radius)) {
+      out.points.push_back({k, index});
+    }
+  }
+  out.num_candidates = static_cast<int>(out.points.size());
+  out.idepths.reserve(out.points.size());
+
+  LeastSquaresProblem& problem = out.problem;
+  for (int k = 0; k < n; ++k) {
+    problem.AddParameterBlock(out.poses[k].data(), kPoseAmbientSize,
+                              std::make_unique<SE3Manifold>());
+    problem.AddParameterBlock(out.brightness[k].data(), kBrightnessSize);
+  }
+  problem.SetParameterBlockConstant(out.poses[0].data());
+  problem.SetParameterBlockConstant(out.brightness[0].data());
+  const bool affine = options_.brightness == BrightnessModel::kAffine;
+  for (int k = 1; k < n; ++k) {
+    if (!affine) {
+      problem.SetParameterBlockConstant(out.brightness[k].data());
+      continue;
+    }
+    Eigen::Matrix2d sqrt_information = Eigen::Matrix2d::Zero();
+    sqrt_information(0, 0) = 1.0 / options_.brightness_prior_sigma_a;
+    sqrt_information(1, 1) = 1.0 / options_.brightness_prior_sigma_b;
+    problem.AddResidualBlock(
+        std::make_unique<ceres::NormalPrior>(
+            sqrt_information, Eigen::Vector2d(out.brightness[k][0], out.brightness[k][1])),
+        nullptr, {out.brightness[k].data()});
+  }
+  AddScaleGauge(&out);
+
+  ceres::LossFunction* loss = nullptr;
+  if (std::unique_ptr<ceres::LossFunction> made = MakeLossFunction(options_.weighting)) {
+    loss = problem.AddLossFunction(std::move(made));
+  }
+  ceres::LossFunction* loss_inside = loss_in_problem_ ? nullptr : loss;
+  ceres::LossFunction* loss_outside = loss_in_problem_ ? loss : nullptr;
+  const bool photometric = UsesPhotometric(options_.weighting.policy);
+  const bool lines = options_.lines && UsesLines(options_.weighting.policy);
+
+  std::vector<SE3> world_poses(n);
+  for (int k = 0; k < n; ++k) world_poses[k] = PoseFromParameters(out.poses[k].data());
+  auto position_of = [&](int id) {
+    for (int k = 0; k < n; ++k) {
+      if (keyframe(k).id == id) return k;
+    }
+    return -1;
+  };
+
+  // The blocks of one point, collected before its inverse-depth block is added (a point with
+  // too few targets is left out entirely).
+  struct PendingPhotometric {
+    int target;
+    std::vector<HostPixel> pattern;
+  };
+  struct PendingLine {
+    int target;
+    Eigen::Vector3d line;
+    double sqrt_info;
+  };
+  std::vector<WindowedBAProblemPoint> kept_points;
+  for (const WindowedBAProblemPoint& selected : out.points) {
+    const int host = selected.host;
+    const WindowedBAKeyframe& host_keyframe = keyframe(host);
+    const WindowedBAPoint& point = host_keyframe.points[selected.point_index];
+    std::vector<PendingPhotometric> pending_photometric;
+    std::vector<PendingLine> pending_lines;
+    for (int target = 0; target < n && photometric; ++target) {
+      if (target == host) continue;
+      const SE3 target_from_host = world_poses[target] * world_poses[host].Inverse();
+      PendingPhotometric pending{target, {}};
+      for (int p = 0; p < (dso8 ? 8 : 1); ++p) {
+        Eigen::Vector2d offset = Eigen::Vector2d::Zero();
+        if (dso8) offset << kDso8Pattern[p][0], kDso8Pattern[p][1];
+        HostPixel pixel;
+        pixel.pixel_in_host = point.pixel + offset;
+        pixel.intensity_host = host_keyframe.pyramid->SampleIntensity(0, pixel.pixel_in_host.x(),
+                                                                      pixel.pixel_in_host.y());
+        // eq. 5 at the linearisation point; 0 where the row's reprojection is not samplable.
+        pixel.sqrt_info = PhotometricSqrtInfo(options_.weighting, camera, *keyframe(target).pyramid,
+                                              0, target_from_host, pixel.pixel_in_host,
+                                              point.idepth, point.idepth_var);
+        if (pixel.sqrt_info > 0.0) pending.pattern.push_back(pixel);
+      }
+      // A target where part of the pattern falls outside is left out: the rows would switch
+      // on and off as the estimate moves.
+      if (static_cast<int>(pending.pattern.size()) == (dso8 ? 8 : 1)) {
+        pending_photometric.push_back(std::move(pending));
+      }
+    }
+    if (lines && point.edge_id >= 0) {
+      for (const WindowedBALineObservation& observation : host_keyframe.line_observations) {
+        if (observation.edge_id != point.edge_id) continue;
+        const int target = position_of(observation.target_id);
+        if (target < 0 || target == host) continue;
+        const SE3 target_from_host = world_poses[target] * world_poses[host].Inverse();
+        Eigen::Vector2d pixel_in_target;
+        if (!Reproject(camera, target_from_host, point.pixel, point.idepth, &pixel_in_target) ||
+            !camera.IsInside(pixel_in_target, 0.0)) {
+          continue;
+        }
+        const double sqrt_info =
+            LineSqrtInfo(options_.weighting, camera, target_from_host, point.pixel, point.idepth,
+                         point.idepth_var, observation.line_in_target);  // eq. 6
+        if (sqrt_info > 0.0) {
+          pending_lines.push_back({target, observation.line_in_target.line, sqrt_info});
+        }
+      }
+    }
+    const int targets = static_cast<int>(pending_photometric.size() + pending_lines.size());
+    if (targets < options_.min_targets) continue;
+    out.idepths.push_back(point.idepth);
+    double* idepth = &out.idepths.back();
+    problem.AddParameterBlock(idepth, 1);
+    problem.SetParameterBlockEliminated(idepth);
+    if (options_.idepth_prior_scale > 0.0) {
+      const double sigma = options_.idepth_prior_scale * std::sqrt(point.idepth_var);
+      problem.AddResidualBlock(
+          std::make_unique<ceres::NormalPrior>(ceres::Matrix::Constant(1, 1, 1.0 / sigma),
+                                               ceres::Vector::Constant(1, point.idepth)),
+          nullptr, {idepth});
+    }
+    kept_points.push_back(selected);
+    for (PendingPhotometric& pending : pending_photometric) {
+      out.num_photometric_rows += static_cast<int>(pending.pattern.size());
+      ++out.num_photometric_blocks;
+      problem.AddResidualBlock(
+          std::unique_ptr<ceres::CostFunction>(HostTargetPhotometricResidual::Create(
+              *keyframe(pending.target).pyramid, 0, camera, std::move(pending.pattern), loss_inside,
+              options_.interpolation)),
+          loss_outside,
+          {out.poses[host].data(), out.poses[pending.target].data(), idepth,
+           out.brightness[host].data(), out.brightness[pending.target].data()});
+    }
+    for (const PendingLine& pending : pending_lines) {
+      ++out.num_line_rows;
+      problem.AddResidualBlock(
+          std::unique_ptr<ceres::CostFunction>(HostTargetPointToLineResidual::Create(
+              camera, point.pixel, pending.line, pending.sqrt_info, loss_inside)),
+          loss_outside, {out.poses[host].data(), out.poses[pending.target].data(), idepth});
+    }
+  }
+  out.points = std::move(kept_points);
+  return out;
+}
+
+}  // namespace
+
+std::string WindowedBAOptions::Check() const {
+  const auto registry = WindowedBAProblemBuilderRegistry();
+  if (registry.count(problem_builder) == 0) {
+    return "problem_builder '" + problem_builder + "' unknown; known: " + RegistryNames(registry);
+  }
+  if (window < 2) return "window must be >= 2";
+  if (max_points < 1) return "max_points must be >= 1";
+  if (!(min_gradient >= 0.0) || !std::isfinite(min_gradient)) return "min_gradient must be >= 0";
+  if (min_targets < 1) return "min_targets must be >= 1";
+  if (!(idepth_prior_scale >= 0.0) || !std::isfinite(idepth_prior_scale)) {
+    return "idepth_prior_scale must be >= 0 and finite";
+  }
+  if (!(brightness_prior_sigma_a > 0.0) || !(brightness_prior_sigma_b > 0.0) ||
+      !std::isfinite(brightness_prior_sigma_a) || !std::isfinite(brightness_prior_sigma_b)) {
+    return "brightness_prior_sigma_a and brightness_prior_sigma_b must be positive and finite";
+  }
+  if (!(baseline_prior_sigma_ratio > 0.0) || !std::isfinite(baseline_prior_sigma_ratio)) {
+    return "baseline_prior_sigma_ratio must be positive and finite";
+  }
+  if (max_iterations < 0) return "max_iterations must be >= 0";
+  if (!(function_tolerance >= 0.0)) return "function_tolerance must be >= 0";
+  if (num_threads < 1) return "num_threads must be >= 1";
+  const std::string weighting_error = weighting.Check();
+  if (!weighting_error.empty()) return "weighting: " + weighting_error;
+  return "";
+}
+
+std::map<std::string, WindowedBAProblemBuilderFactory> WindowedBAProblemBuilderRegistry() {
+  std::map<std::string, WindowedBAProblemBuilderFactory> registry;
+  registry["windowed_ba"] = [](const WindowedBAOptions& options) {
+    return std::make_unique<PhotometricLineWindowBuilder>(options, /*loss_in_problem=*/false);
+  };
+  registry["windowed_ba_ceres_loss"] = [](const WindowedBAOptions& options) {
+    return std::make_unique<PhotometricLineWindowBuilder>(options, /*loss_in_problem=*/true);
+  };
+  return registry;
+}
+
+std::unique_ptr<WindowedBAProblemBuilder> MakeWindowedBAProblemBuilder(
+    const std::string& name, const WindowedBAOptions& options) {
+  return FindInRegistry(WindowedBAProblemBuilderRegistry(), name,
+                        "windowed BA problem builder")(options);
+}
+
+}  // namespace pldvo

@@ -1,0 +1,115 @@
+#include "backend/windowed_ba/windowed_ba_solver.h"
+
+#include <ceres/ordered_groups.h>
+#include <ceres/problem.h>
+
+#include <chrono>
+#include <memory>
+#include <stdexcept>
+
+#include "backend/optimization/gauss_newton_solver.h"
+#include "residuals/se3_manifold.h"
+
+namespace pldvo {
+namespace {
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+ceres::Solver::Options MakeWindowedBACeresOptions(const WindowedBAOptions& options,
+                                                  const WindowedBAProblem& problem) {
+  ceres::Solver::Options solver_options;
+  solver_options.minimizer_type = ceres::TRUST_REGION;
+  solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.function_tolerance = options.function_tolerance;
+  solver_options.num_threads = options.num_threads;
+  solver_options.logging_type = ceres::SILENT;
+  solver_options.minimizer_progress_to_stdout = false;
+  const bool suitesparse = ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE);
+  solver_options.sparse_linear_algebra_library_type =
+      suitesparse ? ceres::SUITE_SPARSE : ceres::EIGEN_SPARSE;
+  switch (options.linear_solver) {
+    case WindowedBALinearSolver::kSparseSchur:
+      solver_options.linear_solver_type = ceres::SPARSE_SCHUR;
+      break;
+    case WindowedBALinearSolver::kDenseSchur:
+      solver_options.linear_solver_type = ceres::DENSE_SCHUR;
+      break;
+    case WindowedBALinearSolver::kSparseNormalCholesky:
+      solver_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+      break;
+  }
+  // Inverse depths (group 0) eliminated first; every other block, constant ones included, in
+  // group 1.
+  const std::vector<double*> eliminated = problem.problem.EliminatedBlocks();
+  if (!eliminated.empty()) {
+    auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+    for (const LeastSquaresProblem::ParameterBlock& block : problem.problem.parameter_blocks()) {
+      ordering->AddElementToGroup(block.values, block.eliminated && !block.constant ? 0 : 1);
+    }
+    solver_options.linear_solver_ordering = ordering;
+  }
+  return solver_options;
+}
+
+SolverSummary SolveWindowedBAProblem(const WindowedBAOptions& options, WindowedBAProblem* problem) {
+  SolverSummary summary;
+  if (problem->problem.residual_blocks().empty() || problem->points.empty()) {
+    summary.message = "no points with observations in the window";
+    return summary;
+  }
+  if (options.solver == WindowedBASolver::kGaussNewton) {
+    SolverOptions solver_options;
+    solver_options.type = SolverOptions::Type::kGaussNewton;
+    solver_options.max_iterations = options.max_iterations;
+    solver_options.function_tolerance = options.function_tolerance;
+    // Damped from the first step, as Ceres' LM with its initial trust region radius 1e4 is
+    // (mu = 1 / radius on the scaled diagonal): an undamped first step can leave the basin the
+    // photometric rows define.
+    solver_options.initial_lambda = 1e-4;
+    return GaussNewtonSolver(solver_options).Solve(&problem->problem);
+  }
+  std::unique_ptr<ceres::Problem> ceres_problem = problem->problem.ToCeresProblem();
+  const ceres::Solver::Options solver_options = MakeWindowedBACeresOptions(options, *problem);
+  ceres::Solver::Summary ceres_summary;
+  ceres::Solve(solver_options, ceres_problem.get(), &ceres_summary);
+  summary.iterations = std::max(0, static_cast<int>(ceres_summary.iterations.size()) - 1);
+  summary.accepted_iterations = ceres_summary.num_successful_steps;
+  summary.initial_cost = ceres_summary.initial_cost;
+  summary.final_cost = ceres_summary.final_cost;
+  summary.converged = ceres_summary.termination_type == ceres::CONVERGENCE;
+  summary.message = ceres_summary.message;
+  return summary;
+}
+
+WindowedBAResult RunWindowedBA(const WindowedBAWindow& window, const WindowedBAOptions& options) {
+  const auto build_start = std::chrono::steady_clock::now();
+  WindowedBAProblem problem =
+      MakeWindowedBAProblemBuilder(options.problem_builder, options)->Build(window);
+  WindowedBAResult result;
+  result.build_seconds = SecondsSince(build_start);
+  result.num_photometric_rows = problem.num_photometric_rows;
+  result.num_line_rows = problem.num_line_rows;
+  const auto solve_start = std::chrono::steady_clock::now();
+  result.summary = SolveWindowedBAProblem(options, &problem);
+  result.solve_seconds = SecondsSince(solve_start);
+  for (size_t k = 0; k < problem.keyframe_indices.size(); ++k) {
+    WindowedBAResultKeyframe keyframe;
+    keyframe.id = window.keyframes[problem.keyframe_indices[k]].id;
+    keyframe.cam_from_world = PoseFromParameters(problem.poses[k].data());
+    keyframe.brightness = {problem.brightness[k][0], problem.brightness[k][1]};
+    result.keyframes.push_back(keyframe);
+  }
+  for (size_t i = 0; i < problem.points.size(); ++i) {
+    const WindowedBAProblemPoint& point = problem.points[i];
+    result.points.push_back({window.keyframes[problem.keyframe_indices[point.host]].id,
+                             point.point_index, problem.idepths[i]});
+  }
+  return result;
+}
+
+}  // namespace pldvo

@@ -1,0 +1,323 @@
+// Windowed photometric + line bundle adjustment (backend/windowed_ba, docs/windowed_ba.md) on the
+// hand-made scene of experiments/evaluation/windowed_ba_simulation.h: error reduction from
+// perturbed starts, Ceres and Gauss-Newton on the same window, the gauge, the weights, point
+// selection, the builder registry and the options.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "backend/windowed_ba/point_selection.h"
+#include "backend/windowed_ba/windowed_ba_problem_builder.h"
+#include "backend/windowed_ba/windowed_ba_solver.h"
+#include "core/config_io.h"
+#include "experiments/evaluation/windowed_ba_simulation.h"
+#include "residuals/host_target_photometric_residual.h"
+#include "residuals/se3_manifold.h"
+#include "residuals/weighting.h"
+#include "tests/sanitizer_budget.h"
+
+namespace pldvo {
+namespace {
+
+std::vector<SE3> Poses(const WindowedBAResult& result) {
+  std::vector<SE3> poses;
+  for (const WindowedBAResultKeyframe& keyframe : result.keyframes) {
+    poses.push_back(keyframe.cam_from_world);
+  }
+  return poses;
+}
+
+Eigen::Vector3d Centre(const SE3& cam_from_world) { return cam_from_world.Inverse().translation(); }
+
+// The default window (4 keyframes 10 cm apart, 320x240, poses off by 2.5 mm / 0.1 deg per axis,
+// inverse depths by 2.5%, brightness off by up to 0.05 in a and 9 gray levels in b), solved with
+// the defaults (builder windowed_ba, ceres SPARSE_SCHUR, 800 points): measured rotation RMS
+// 0.110 -> 0.035 deg, translation RMS (after fitting the scale) 3.92 -> 1.28 mm, median relative
+// inverse-depth error 1.80% -> 0.98%; from the true state the solution moves by 0.017 deg and
+// 0.7 mm (the rendering is not exactly photo-consistent), a floor for these factors. Bounds:
+// pose errors halved, the median depth error cut by a third. Breaking it: with the sign of the
+// host pose's translation Jacobian flipped (photometric residual) the translation error grows
+// to 5.48 mm and the test fails.
+TEST(WindowedBATest, ReducesPoseAndDepthErrorFromPerturbedStart) {
+  PLDVO_RELEASE_ONLY_ACCURACY_TEST("WindowedBATest.CeresAndGaussNewtonAgreeOnTheSameWindow");
+  WindowedBASimulationOptions simulation_options;
+  simulation_options.num_keyframes = 4;
+  const WindowedBASimulation simulation = SimulateWindowedBAWindow(simulation_options);
+  WindowedBAOptions options;
+  options.window = 4;
+  options.max_points = 800;
+  options.max_iterations = 50;
+  const WindowedBAResult result = RunWindowedBA(simulation.window, options);
+  ASSERT_TRUE(result.summary.converged) << result.summary.message;
+  EXPECT_GT(result.points.size(), 600u);
+  EXPECT_GT(result.num_line_rows, 50);
+  EXPECT_LT(result.summary.final_cost, 0.2 * result.summary.initial_cost);
+  const WindowedBAErrors before = EvaluateWindowedBAInput(simulation, result.points);
+  const WindowedBAErrors after = EvaluateWindowedBA(simulation, Poses(result), result.points);
+  EXPECT_LT(after.rotation_rms_deg, 0.5 * before.rotation_rms_deg);
+  EXPECT_LT(after.translation_rms_m, 0.5 * before.translation_rms_m);
+  EXPECT_LT(after.idepth_relative_median, 0.67 * before.idepth_relative_median);
+  std::printf(
+      "rotation %.4f -> %.4f deg, translation %.2f -> %.2f mm, idepth median %.4f -> "
+      "%.4f, %zu points, %d iterations\n",
+      before.rotation_rms_deg, after.rotation_rms_deg, 1e3 * before.translation_rms_m,
+      1e3 * after.translation_rms_m, before.idepth_relative_median, after.idepth_relative_median,
+      result.points.size(), result.summary.iterations);
+}
+
+// A small window (3 keyframes, 200x150, 300 points), bicubic sampling (the cost is C1 and the
+// Jacobians exact), solved by Ceres (SPARSE_SCHUR, inverse depths eliminated) and by the
+// hand-written Gauss-Newton (Schur on the inverse depths) from the same start. Both end in a
+// slow final crawl (Ceres' trust-region ratio stays near 0.4 for tens of iterations, cause not
+// yet found, docs/windowed_ba.md) and stop on the parameter tolerance, so they agree to that
+// crawl, not to rounding: measured final costs 129.979 / 130.000 (1.7e-4 relative), poses within
+// 8.7e-5 m and 2.1e-5 rad, median relative inverse-depth difference 1.3e-4 (worst point 1.6e-2).
+// Bounds 1e-3 relative cost, 5e-4 m, 1e-4 rad, 1e-3 median: about 5x the measurements, far
+// below the start's perturbation (2.5 mm, 1.7e-3 rad per axis, 2.5% depth). Breaking it: a
+// wrong Schur step, a block left out of the Ceres ordering or different objectives part them.
+TEST(WindowedBATest, CeresAndGaussNewtonAgreeOnTheSameWindow) {
+  WindowedBASimulationOptions simulation_options;
+  simulation_options.num_keyframes = 3;
+  simulation_options.width = 200;
+  simulation_options.height = 150;
+  simulation_options.focal = 164.0;
+  const WindowedBASimulation simulation = SimulateWindowedBAWindow(simulation_options);
+  WindowedBAOptions options;
+  options.window = 3;
+  options.max_points = 300;
+  options.interpolation = ImageInterpolation::kBicubic;
+  options.max_iterations = 100;
+  options.function_tolerance = 1e-10;
+  options.solver = WindowedBASolver::kCeres;
+  const WindowedBAResult ceres = RunWindowedBA(simulation.window, options);
+  options.solver = WindowedBASolver::kGaussNewton;
+  const WindowedBAResult gauss_newton = RunWindowedBA(simulation.window, options);
+  ASSERT_TRUE(ceres.summary.converged) << ceres.summary.message;
+  ASSERT_TRUE(gauss_newton.summary.converged) << gauss_newton.summary.message;
+  EXPECT_LT(ceres.summary.final_cost, 0.5 * ceres.summary.initial_cost);
+  EXPECT_DOUBLE_EQ(ceres.summary.initial_cost, gauss_newton.summary.initial_cost);
+  EXPECT_NEAR(gauss_newton.summary.final_cost, ceres.summary.final_cost,
+              1e-3 * ceres.summary.final_cost);
+  ASSERT_EQ(ceres.keyframes.size(), gauss_newton.keyframes.size());
+  double worst_translation = 0.0, worst_rotation = 0.0, worst_idepth = 0.0;
+  for (size_t k = 0; k < ceres.keyframes.size(); ++k) {
+    const SE3 difference =
+        gauss_newton.keyframes[k].cam_from_world * ceres.keyframes[k].cam_from_world.Inverse();
+    const Vector6d twist = difference.Log();
+    worst_translation = std::max(worst_translation, twist.head<3>().norm());
+    worst_rotation = std::max(worst_rotation, twist.tail<3>().norm());
+  }
+  ASSERT_EQ(ceres.points.size(), gauss_newton.points.size());
+  std::vector<double> idepth_differences;
+  for (size_t i = 0; i < ceres.points.size(); ++i) {
+    idepth_differences.push_back(
+        std::abs(gauss_newton.points[i].idepth / ceres.points[i].idepth - 1.0));
+    worst_idepth = std::max(worst_idepth, idepth_differences.back());
+  }
+  std::nth_element(idepth_differences.begin(),
+                   idepth_differences.begin() + idepth_differences.size() / 2,
+                   idepth_differences.end());
+  const double median_idepth = idepth_differences[idepth_differences.size() / 2];
+  EXPECT_LT(worst_translation, 5e-4);
+  EXPECT_LT(worst_rotation, 1e-4);
+  EXPECT_LT(median_idepth, 1e-3);
+  std::printf(
+      "cost %.9g (ceres, %d it) vs %.9g (gauss-newton, %d it); worst differences: "
+      "%.2g m, %.2g rad, relative idepth median %.2g worst %.2g\n",
+      ceres.summary.final_cost, ceres.summary.iterations, gauss_newton.summary.final_cost,
+      gauss_newton.summary.iterations, worst_translation, worst_rotation, median_idepth,
+      worst_idepth);
+}
+
+// Built problem: the gauge (oldest pose and brightness constant, a baseline prior to the next
+// keyframe), one eliminated 1-D block per point, the photometric weights from eq. 5 at the
+// linearisation point (recomputed here for every row of a block), not constants.
+TEST(WindowedBATest, ProblemHasTheGaugeAndCovarianceWeights) {
+  WindowedBASimulationOptions simulation_options;
+  simulation_options.num_keyframes = 3;
+  simulation_options.width = 160;
+  simulation_options.height = 120;
+  simulation_options.focal = 131.0;
+  const WindowedBASimulation simulation = SimulateWindowedBAWindow(simulation_options);
+  WindowedBAOptions options;
+  options.window = 3;
+  options.max_points = 150;
+  const WindowedBAProblem problem =
+      MakeWindowedBAProblemBuilder("windowed_ba", options)->Build(simulation.window);
+  const LeastSquaresProblem& lsq = problem.problem;
+  ASSERT_EQ(problem.poses.size(), 3u);
+  EXPECT_TRUE(lsq.parameter_blocks()[lsq.ParameterBlockIndex(problem.poses[0].data())].constant);
+  EXPECT_TRUE(
+      lsq.parameter_blocks()[lsq.ParameterBlockIndex(problem.brightness[0].data())].constant);
+  for (int k = 1; k < 3; ++k) {
+    EXPECT_FALSE(lsq.parameter_blocks()[lsq.ParameterBlockIndex(problem.poses[k].data())].constant);
+  }
+  EXPECT_EQ(problem.baseline_keyframe_a, 0);
+  EXPECT_EQ(problem.baseline_keyframe_b, 1);
+  EXPECT_NEAR(problem.baseline,
+              (Centre(simulation.window.keyframes[1].cam_from_world) -
+               Centre(simulation.window.keyframes[0].cam_from_world))
+                  .norm(),
+              1e-12);
+  EXPECT_EQ(lsq.EliminatedBlocks().size(), problem.points.size());
+  EXPECT_GT(problem.points.size(), 50u);
+
+  // Every photometric row's sqrt_info is PhotometricSqrtInfo at the input (eq. 5); they differ
+  // from row to row.
+  std::set<double> weights;
+  int checked = 0;
+  for (const LeastSquaresProblem::ResidualBlock& block : lsq.residual_blocks()) {
+    const auto* photometric =
+        dynamic_cast<const HostTargetPhotometricResidual*>(block.cost_function);
+    if (photometric == nullptr) continue;
+    int host = -1, target = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (block.parameters[0] == problem.poses[k].data()) host = k;
+      if (block.parameters[1] == problem.poses[k].data()) target = k;
+    }
+    ASSERT_GE(host, 0);
+    ASSERT_GE(target, 0);
+    const int point = static_cast<int>(block.parameters[2] - problem.idepths.data());
+    const WindowedBAPoint& input = simulation.window.keyframes[problem.points[point].host]
+                                       .points[problem.points[point].point_index];
+    const SE3 target_from_host = simulation.window.keyframes[target].cam_from_world *
+                                 simulation.window.keyframes[host].cam_from_world.Inverse();
+    for (const HostPixel& pixel : photometric->pattern()) {
+      EXPECT_DOUBLE_EQ(
+          pixel.sqrt_info,
+          PhotometricSqrtInfo(options.weighting, simulation.window.camera,
+                              *simulation.window.keyframes[target].pyramid, 0, target_from_host,
+                              pixel.pixel_in_host, input.idepth, input.idepth_var));
+      weights.insert(pixel.sqrt_info);
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 1000);
+  EXPECT_GT(weights.size(), 100u);
+  EXPECT_GT(problem.num_line_rows, 0);
+
+  // Without lines, no point-to-line rows; with brightness none, every brightness block constant.
+  options.lines = false;
+  options.brightness = BrightnessModel::kNone;
+  const WindowedBAProblem without =
+      MakeWindowedBAProblemBuilder("windowed_ba", options)->Build(simulation.window);
+  EXPECT_EQ(without.num_line_rows, 0);
+  for (const auto& brightness : without.brightness) {
+    EXPECT_TRUE(
+        without.problem.parameter_blocks()[without.problem.ParameterBlockIndex(brightness.data())]
+            .constant);
+  }
+}
+
+// After a solve the gauge holds: the oldest pose and brightness are the inputs, the baseline to
+// the second keyframe is the input's. Without inverse-depth priors the data are exactly
+// scale-invariant, so the baseline prior's residual is 0 at the optimum; the solve stops in the
+// slow crawl of the test above: measured 5.4e-4 relative from the input baseline (bound 2e-3,
+// against the prior's sigma of 1e-2 and the inputs' scale error of a few percent).
+TEST(WindowedBATest, SolveKeepsTheGauge) {
+  WindowedBASimulationOptions simulation_options;
+  simulation_options.num_keyframes = 3;
+  simulation_options.width = 160;
+  simulation_options.height = 120;
+  simulation_options.focal = 131.0;
+  const WindowedBASimulation simulation = SimulateWindowedBAWindow(simulation_options);
+  WindowedBAOptions options;
+  options.window = 3;
+  options.max_points = 150;
+  options.problem_builder = "windowed_ba_ceres_loss";
+  options.idepth_prior_scale = 0.0;
+  options.max_iterations = 50;
+  const WindowedBAResult result = RunWindowedBA(simulation.window, options);
+  ASSERT_TRUE(result.summary.converged) << result.summary.message;
+  EXPECT_LT(result.summary.final_cost, result.summary.initial_cost);
+  const SE3& oldest = simulation.window.keyframes[0].cam_from_world;
+  EXPECT_LT((result.keyframes[0].cam_from_world.translation() - oldest.translation()).norm(),
+            1e-15);
+  EXPECT_EQ(result.keyframes[0].brightness.a, simulation.window.keyframes[0].brightness.a);
+  const double input_baseline =
+      (Centre(simulation.window.keyframes[1].cam_from_world) - Centre(oldest)).norm();
+  const double baseline =
+      (Centre(result.keyframes[1].cam_from_world) - Centre(result.keyframes[0].cam_from_world))
+          .norm();
+  EXPECT_NEAR(baseline, input_baseline, 2e-3 * input_baseline);
+  std::printf("baseline relative change %.3g\n", baseline / input_baseline - 1.0);
+}
+
+// Point selection: at most the budget, at most one point per cell, the best gradient of each
+// cell, none below min_gradient or with its pattern outside the image.
+TEST(WindowedBATest, PointSelectionSpreadsTheBestGradients) {
+  cv::Mat image(100, 100, CV_32F);
+  for (int y = 0; y < 100; ++y) {
+    for (int x = 0; x < 100; ++x) image.at<float>(y, x) = static_cast<float>(0.1 * x * x);
+  }
+  const ImagePyramid pyramid(image, 1);  // gradient 0.2 x: grows to the right
+  std::vector<WindowedBAPoint> points;
+  for (int y = 1; y < 99; y += 2) {
+    for (int x = 1; x < 99; x += 2) {
+      WindowedBAPoint point;
+      point.pixel = Eigen::Vector2d(x, y);
+      point.idepth = 1.0;
+      point.idepth_var = 1.0;
+      points.push_back(point);
+    }
+  }
+  const int budget = 25;  // cells of 20 x 20 px
+  const std::vector<int> selected = SelectWindowPoints(points, pyramid, budget, 3.0, 2.0);
+  EXPECT_LE(selected.size(), 25u);
+  EXPECT_GE(selected.size(), 15u);  // columns x < 15 have gradient < 3
+  std::set<std::pair<int, int>> cells;
+  for (const int index : selected) {
+    const Eigen::Vector2d& pixel = points[index].pixel;
+    EXPECT_GE(0.2 * pixel.x(), 3.0);
+    EXPECT_GE(pixel.x(), 3.0);
+    EXPECT_LT(pixel.x(), 100 - 4.0);
+    EXPECT_TRUE(
+        cells.insert({static_cast<int>(pixel.x() / 20), static_cast<int>(pixel.y() / 20)}).second);
+    // The best of its cell: the largest x in the cell the pattern allows.
+    const int cell_right = std::min(95, (static_cast<int>(pixel.x() / 20) + 1) * 20 - 1);
+    EXPECT_GE(pixel.x(), cell_right - 2);
+  }
+  EXPECT_TRUE(SelectWindowPoints(points, pyramid, 0, 0.0, 2.0).empty());
+}
+
+// The registry: both builders by name; an unknown name lists the known ones. The options: read
+// from YAML text through VisitFields, unknown keys rejected, Check() names bad values.
+TEST(WindowedBATest, RegistryAndOptions) {
+  const auto registry = WindowedBAProblemBuilderRegistry();
+  EXPECT_EQ(registry.size(), 2u);
+  EXPECT_EQ(registry.count("windowed_ba"), 1u);
+  EXPECT_EQ(registry.count("windowed_ba_ceres_loss"), 1u);
+  const WindowedBAOptions defaults;
+  EXPECT_NE(MakeWindowedBAProblemBuilder("windowed_ba_ceres_loss", defaults), nullptr);
+  try {
+    MakeWindowedBAProblemBuilder("no_such_builder", defaults);
+    ADD_FAILURE() << "unknown builder accepted";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("windowed_ba windowed_ba_ceres_loss"),
+              std::string::npos)
+        << error.what();
+  }
+  EXPECT_EQ(defaults.Check(), "");
+  WindowedBAOptions options;
+  ApplyOverrides({"problem_builder=windowed_ba_ceres_loss", "window=7", "solver=gauss_newton",
+                  "weighting.robust_loss=cauchy"},
+                 &options);
+  EXPECT_EQ(options.problem_builder, "windowed_ba_ceres_loss");
+  EXPECT_EQ(options.window, 7);
+  EXPECT_EQ(options.solver, WindowedBASolver::kGaussNewton);
+  EXPECT_EQ(options.weighting.robust_loss, RobustLossKind::kCauchy);
+  EXPECT_THROW(ApplyOverrides({"no_such_key=1"}, &options), std::invalid_argument);
+  options.problem_builder = "nope";
+  EXPECT_NE(options.Check().find("known: windowed_ba"), std::string::npos);
+  options = WindowedBAOptions();
+  options.window = 1;
+  EXPECT_NE(options.Check(), "");
+  EXPECT_THROW(MakeWindowedBAProblemBuilder("windowed_ba", options), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace pldvo
