@@ -12,7 +12,7 @@
 //     Sigma_f = 2 sigma_I^2 + (g^T J_d)^2 V (eq. 5), V the depth filter's variance of the point;
 //   - point-to-line (eq. 3, HostTargetPointToLineResidual): each selected point on an edge with
 //     a line observation in another window keyframe, sqrt_info from Sigma_g (eq. 6);
-//   - inverse-depth prior: N(input, (idepth_prior_scale^2) V) on each point (weak, see options);
+//   - inverse-depth prior: N(input, (idepth_prior_scale^2) V) on each point (see the options);
 //   - brightness prior: N(input, diag(sigma_a^2, sigma_b^2)) on every keyframe's {a, b} but the
 //     oldest's (with brightness affine).
 //
