@@ -70,16 +70,17 @@ struct WindowedBAOptions {
   // A prior N(input idepth, (idepth_prior_scale^2) V) on each point's inverse depth, V the
   // depth filter's variance: the filter's estimate as information. It regularises the depth of a
   // point whose rows hardly constrain it (image gradient across its epipolar lines, one
-  // short-baseline target), and with it the poses: on the simulated windows of
-  // docs/windowed_ba.md 1 (the filter's variance as it is) measured better pose errors than 10
-  // or none on 4 of 5 seeds. The priors also carry the inputs' scale, so they trade off against
-  // the baseline prior when input poses and depths disagree in scale. 0: no prior (DSO).
+  // short-baseline target), and with it the poses; 1 takes the filter's variance as it is
+  // (docs/windowed_ba.md, "Inverse-depth prior", compares 0, 1 and 10). The priors also carry
+  // the inputs' scale, so they trade off against the baseline prior when input poses and depths
+  // disagree in scale. 0: no prior (DSO).
   double idepth_prior_scale = 1.0;
   // Point-to-line rows (eq. 3) for selected points on edges with a line observation in another
   // window keyframe (off: photometric only).
   bool lines = true;
-  // sigma_b of the baseline prior (the scale gauge) as a fraction of the baseline. Any value > 0
-  // gives the same optimum (the data are scale-invariant); 1e-2 keeps the system conditioned.
+  // sigma_b of the baseline prior (the scale gauge) as a fraction of the baseline. Without
+  // inverse-depth priors any value > 0 gives the same optimum (the rows are scale-invariant);
+  // 1e-2 keeps the system conditioned.
   double baseline_prior_sigma_ratio = 1e-2;
   // Weighting (eq. 5, eq. 6 covariance models; sigma_I; robust loss and its threshold).
   WeightingOptions weighting;
