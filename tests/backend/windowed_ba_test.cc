@@ -99,7 +99,9 @@ TEST(WindowedBATest, CeresAndGaussNewtonAgreeOnTheSameWindow) {
   ASSERT_TRUE(ceres.summary.converged) << ceres.summary.message;
   ASSERT_TRUE(gauss_newton.summary.converged) << gauss_newton.summary.message;
   EXPECT_LT(ceres.summary.final_cost, 0.5 * ceres.summary.initial_cost);
-  EXPECT_DOUBLE_EQ(ceres.summary.initial_cost, gauss_newton.summary.initial_cost);
+  // The same objective at the same start; Ceres sums the blocks in its own order (1e-12).
+  EXPECT_NEAR(ceres.summary.initial_cost, gauss_newton.summary.initial_cost,
+              1e-12 * ceres.summary.initial_cost);
   EXPECT_NEAR(gauss_newton.summary.final_cost, ceres.summary.final_cost,
               1e-7 * ceres.summary.final_cost);
   ASSERT_EQ(ceres.keyframes.size(), gauss_newton.keyframes.size());
