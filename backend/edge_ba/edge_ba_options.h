@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "backend/optimization/ba_linear_solver.h"
 #include "core/options.h"
 #include "residuals/weighting.h"
 
@@ -38,14 +39,7 @@ inline const ChoiceNames<EdgeBALeavingLines>& EdgeBALeavingLinesNames() {
   return names;
 }
 
-enum class EdgeBALinearSolver { kSparseSchur, kDenseSchur, kSparseNormalCholesky };
-inline const ChoiceNames<EdgeBALinearSolver>& EdgeBALinearSolverNames() {
-  static const ChoiceNames<EdgeBALinearSolver> names = {
-      {"sparse_schur", EdgeBALinearSolver::kSparseSchur},
-      {"dense_schur", EdgeBALinearSolver::kDenseSchur},
-      {"sparse_normal_cholesky", EdgeBALinearSolver::kSparseNormalCholesky}};
-  return names;
-}
+using EdgeBALinearSolver = BALinearSolver;
 
 struct EdgeBAOptions {
   // Off by default: the odometry runs without BA unless asked.
@@ -134,7 +128,7 @@ struct EdgeBAOptions {
             "Translation sigma of the motion prior as a fraction of |t| (default 0.01).");
     v.Field("motion_prior_rotation_deg", &motion_prior_rotation_deg,
             "Rotation sigma of the motion prior, degrees (default 0.1).");
-    v.Choice("linear_solver", &linear_solver, EdgeBALinearSolverNames(),
+    v.Choice("linear_solver", &linear_solver, BALinearSolverNames(),
              "sparse_schur (SuiteSparse, lines eliminated first), dense_schur, "
              "sparse_normal_cholesky.");
     v.Field("num_threads", &num_threads, "Ceres threads per solve.");

@@ -9,6 +9,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "backend/optimization/bundle_adjustment_options.h"
 #include "residuals/se3_manifold.h"
 
 namespace pldvo {
@@ -41,28 +42,9 @@ bool LineCovariances(const std::vector<double*>& lines, ceres::Problem* problem,
 
 ceres::Solver::Options MakeEdgeBASolverOptions(const EdgeBAOptions& options,
                                                EdgeBAProblem* problem) {
-  ceres::Solver::Options solver_options;
-  solver_options.minimizer_type = ceres::TRUST_REGION;
-  solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.function_tolerance = options.function_tolerance;
-  solver_options.num_threads = options.num_threads;
-  solver_options.logging_type = ceres::SILENT;
-  solver_options.minimizer_progress_to_stdout = false;
-  const bool suitesparse = ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE);
-  solver_options.sparse_linear_algebra_library_type =
-      suitesparse ? ceres::SUITE_SPARSE : ceres::EIGEN_SPARSE;
-  switch (options.linear_solver) {
-    case EdgeBALinearSolver::kSparseSchur:
-      solver_options.linear_solver_type = ceres::SPARSE_SCHUR;
-      break;
-    case EdgeBALinearSolver::kDenseSchur:
-      solver_options.linear_solver_type = ceres::DENSE_SCHUR;
-      break;
-    case EdgeBALinearSolver::kSparseNormalCholesky:
-      solver_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-      break;
-  }
+  ceres::Solver::Options solver_options =
+      MakeBundleAdjustmentCeresOptions(options.linear_solver, options.max_iterations,
+                                       options.function_tolerance, options.num_threads);
   // Lines (group 0) are eliminated first; poses (group 1) form the reduced camera system. Every
   // parameter block of the problem must be in the ordering, constant ones included.
   const std::vector<double*> lines = problem->VariableLineBlocks();

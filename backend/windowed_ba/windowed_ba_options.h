@@ -7,6 +7,7 @@
 
 #include <string>
 
+#include "backend/optimization/ba_linear_solver.h"
 #include "core/options.h"
 #include "residuals/affine_brightness.h"
 #include "residuals/photometric_residual.h"
@@ -32,14 +33,7 @@ inline const ChoiceNames<WindowedBASolver>& WindowedBASolverNames() {
   return names;
 }
 
-enum class WindowedBALinearSolver { kSparseSchur, kDenseSchur, kSparseNormalCholesky };
-inline const ChoiceNames<WindowedBALinearSolver>& WindowedBALinearSolverNames() {
-  static const ChoiceNames<WindowedBALinearSolver> names = {
-      {"sparse_schur", WindowedBALinearSolver::kSparseSchur},
-      {"dense_schur", WindowedBALinearSolver::kDenseSchur},
-      {"sparse_normal_cholesky", WindowedBALinearSolver::kSparseNormalCholesky}};
-  return names;
-}
+using WindowedBALinearSolver = BALinearSolver;
 
 struct WindowedBAOptions {
   // The registered problem builder (WindowedBAProblemBuilderRegistry): "windowed_ba" (robust
@@ -119,7 +113,7 @@ struct WindowedBAOptions {
             "sigma of the scale prior as a fraction of the baseline.");
     v.Section("weighting", &weighting, "Weighting of the residual families and robust loss.");
     v.Choice("solver", &solver, WindowedBASolverNames(), "ceres or gauss_newton.");
-    v.Choice("linear_solver", &linear_solver, WindowedBALinearSolverNames(),
+    v.Choice("linear_solver", &linear_solver, BALinearSolverNames(),
              "Ceres linear solver: sparse_schur, dense_schur, sparse_normal_cholesky.");
     v.Field("max_iterations", &max_iterations, "Iterations per window.");
     v.Field("function_tolerance", &function_tolerance, "Relative cost-change tolerance.");

@@ -7,6 +7,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "backend/optimization/bundle_adjustment_options.h"
 #include "backend/optimization/gauss_newton_solver.h"
 #include "residuals/se3_manifold.h"
 
@@ -21,28 +22,9 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 
 ceres::Solver::Options MakeWindowedBACeresOptions(const WindowedBAOptions& options,
                                                   const WindowedBAProblem& problem) {
-  ceres::Solver::Options solver_options;
-  solver_options.minimizer_type = ceres::TRUST_REGION;
-  solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.function_tolerance = options.function_tolerance;
-  solver_options.num_threads = options.num_threads;
-  solver_options.logging_type = ceres::SILENT;
-  solver_options.minimizer_progress_to_stdout = false;
-  const bool suitesparse = ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE);
-  solver_options.sparse_linear_algebra_library_type =
-      suitesparse ? ceres::SUITE_SPARSE : ceres::EIGEN_SPARSE;
-  switch (options.linear_solver) {
-    case WindowedBALinearSolver::kSparseSchur:
-      solver_options.linear_solver_type = ceres::SPARSE_SCHUR;
-      break;
-    case WindowedBALinearSolver::kDenseSchur:
-      solver_options.linear_solver_type = ceres::DENSE_SCHUR;
-      break;
-    case WindowedBALinearSolver::kSparseNormalCholesky:
-      solver_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-      break;
-  }
+  ceres::Solver::Options solver_options =
+      MakeBundleAdjustmentCeresOptions(options.linear_solver, options.max_iterations,
+                                       options.function_tolerance, options.num_threads);
   // Inverse depths (group 0) eliminated first; every other block, constant ones included, in
   // group 1.
   const std::vector<double*> eliminated = problem.problem.EliminatedBlocks();

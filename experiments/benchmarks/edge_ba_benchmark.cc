@@ -56,7 +56,7 @@ void BM_EdgeBAWindow(benchmark::State& state) {
       1e3 * ComputeEdgeBAErrors(simulation, initial, {}).position_rmse_m;
   state.counters["pos_after_mm"] =
       1e3 * ComputeEdgeBAErrors(simulation, result.keyframes, lines).position_rmse_m;
-  state.SetLabel(result.success ? EdgeBALinearSolverNames()[state.range(1)].first + " " +
+  state.SetLabel(result.success ? BALinearSolverNames()[state.range(1)].first + " " +
                                       RobustLossKindNames()[state.range(3)].first +
                                       (options.batch_pixels ? " batched" : " per-pixel")
                                 : "FAILED");
