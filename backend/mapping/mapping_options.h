@@ -134,8 +134,10 @@ struct MappingOptions {
   // inverse-variance weighted mean with variance init_idepth_var.
   int min_neighbors_fill = 8;
 
-  // ---- 3D line regularisation (paper Sec. V-B, eqs. 11-13).
-  bool line_regularization = true;
+  // ---- 3D line regularisation (paper Sec. V-B, eqs. 11-13). Off by default: on the development
+  // set it made points_lines worse on most sequences (docs/mapping.md, "3D line regularisation");
+  // paper.yaml and the ablation `mapping.line_regularization=true` keep it.
+  bool line_regularization = false;
   // kRay1d: the fit along the pixels' rays with the 1-D Mahalanobis gate in inverse depth
   // (LineRegularizer, header comment). kPaper2d: the paper's eqs. 11-13, RANSAC with the 2-D
   // Mahalanobis distance of each point to the line in the edge plane and the closed-form
@@ -248,7 +250,8 @@ struct MappingOptions {
             "Drop hypotheses with fewer compatible neighbours (2).");
     v.Field("min_neighbors_fill", &min_neighbors_fill,
             "Fill invalid candidates with at least this many valid neighbours (8).");
-    v.Field("line_regularization", &line_regularization, "3D line regularisation of edges.");
+    v.Field("line_regularization", &line_regularization,
+            "3D line regularisation of edges, eqs. 11-13 (default false).");
     v.Choice("line_regularization_method", &line_regularization_method,
              {{"ray_1d", LineRegularizationMethod::kRay1d},
               {"paper_2d", LineRegularizationMethod::kPaper2d}},

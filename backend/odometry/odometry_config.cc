@@ -41,10 +41,6 @@ std::string OdometryOptions::Check() const {
   }
   if (two_view_min_inliers < 8) return "two_view_min_inliers must be >= 8";
   if (two_view_max_frames < 1) return "two_view_max_frames must be >= 1";
-  if (two_view_bootstrap && (bootstrap_passes > 1 || init_depth_idepth_var > 0.0)) {
-    return "two_view_bootstrap replaces the monocular start and cannot be combined with "
-           "bootstrap_passes > 1 or init_depth_idepth_var";
-  }
   return "";
 }
 

@@ -140,7 +140,10 @@ struct OdometryOptions {
   // the first frame k <= two_view_max_frames where two_view_min_inliers tracked corners triangulate
   // (essential matrix) with a median parallax of two_view_min_parallax_deg, the poses of frames
   // 1..k bundle-adjusted, and stereo with them; the run starts from it with bootstrap_idepth_var.
-  // Off by default (the random map); when it fails the run starts from the random map.
+  // Off by default (docs/bootstrap.md: where it succeeds at 640x480 the spread over initial maps
+  // collapses, but at 320x240 its map made every run fail); when it fails the run starts from the
+  // random map. bootstrap_passes > 1 and init_depth_idepth_var > 0 ask for another start and
+  // replace it.
   bool two_view_bootstrap = false;
   double two_view_min_parallax_deg = 2.0;
   int two_view_min_inliers = 50;
@@ -198,9 +201,11 @@ struct OdometryOptions {
     v.Field("bootstrap_idepth_var", &bootstrap_idepth_var,
             "Inverse-depth variance of a refined or two-view start map, median inverse depth 1 "
             "(default 0.05).");
-    v.Field("two_view_bootstrap", &two_view_bootstrap,
-            "Monocular: frame 0's map from the two-view geometry of tracked corners and stereo "
-            "with the frames up to the second view; the run starts from it (default false).");
+    v.Field(
+        "two_view_bootstrap", &two_view_bootstrap,
+        "Monocular: frame 0's map from the two-view geometry of tracked corners and stereo "
+        "with the frames up to the second view; the run starts from it unless bootstrap_passes > 1 "
+        "or init_depth_idepth_var > 0 asks for another start (default false).");
     v.Field("two_view_min_parallax_deg", &two_view_min_parallax_deg,
             "Two-view bootstrap: median parallax of the triangulated corners that makes a frame "
             "the second view, deg (default 2).");

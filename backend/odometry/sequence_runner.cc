@@ -144,9 +144,9 @@ struct InitialMap {
   nlohmann::json two_view;   // summary.json `two_view_bootstrap` (null when not run)
 };
 
-// odometry.bootstrap_passes > 1 starts from the refined first map, odometry.two_view_bootstrap
-// from the map of the two-view geometry; either falls back to the random map, said so, when it
-// fails.
+// odometry.bootstrap_passes > 1 starts from the refined first map, odometry.init_depth_idepth_var
+// > 0 from the dataset's depth, otherwise odometry.two_view_bootstrap from the map of the two-view
+// geometry; a bootstrap that fails falls back to the random map, said so.
 InitialMap PrepareInitialMap(const Dataset& dataset, const OdometryConfig& config, int num_frames) {
   InitialMap initial;
   initial.run_config = config;
@@ -167,7 +167,8 @@ InitialMap PrepareInitialMap(const Dataset& dataset, const OdometryConfig& confi
                 << "); the run starts from the random map\n";
     }
   }
-  if (config.odometry.two_view_bootstrap && num_frames > 0) {
+  if (config.odometry.two_view_bootstrap && config.odometry.bootstrap_passes <= 1 &&
+      config.odometry.init_depth_idepth_var <= 0.0 && num_frames > 0) {
     try {
       const TwoViewBootstrap two_view = BootstrapFromTwoViews(dataset, config, num_frames);
       initial.depth = two_view.depth;

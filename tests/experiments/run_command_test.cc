@@ -356,18 +356,29 @@ TEST(RunCommandTest, TwoViewBootstrapStartsTheRunOrFallsBack) {
   EXPECT_NE(log.find("starts from the random map"), std::string::npos) << log;
   EXPECT_TRUE(nlohmann::json::parse(Slurp(two / "summary.json"))["two_view_bootstrap"].is_null());
 
-  for (const std::string& bad : {std::string(" --set odometry.bootstrap_passes=2"),
-                                 std::string(" --set odometry.init_depth_idepth_var=0.0001"),
-                                 std::string(" --set odometry.two_view_min_parallax_deg=0")}) {
-    const fs::path bad_log = TestRoot() / "run_two_view_bad.log";
-    EXPECT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " +
-                        (TestRoot() / "run_two_view_bad").string() +
-                        " --set odometry.two_view_bootstrap=true" + bad,
-                    bad_log),
-              2)
-        << bad;
-    EXPECT_NE(Slurp(bad_log).find("two_view"), std::string::npos) << Slurp(bad_log);
+  // A refinement or a depth start asked for replaces the two-view bootstrap (it does not run, and
+  // its summary entry stays null).
+  for (const std::string& other : {std::string(" --set odometry.bootstrap_passes=2"),
+                                   std::string(" --set odometry.init_depth_idepth_var=0.0001")}) {
+    const fs::path other_run = TestRoot() / "run_two_view_replaced";
+    const fs::path other_log = TestRoot() / "run_two_view_replaced.log";
+    ASSERT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " + other_run.string() +
+                        kDeterministic + " --max_frames 12 --set odometry.two_view_bootstrap=true" +
+                        other,
+                    other_log),
+              0)
+        << other << Slurp(other_log);
+    EXPECT_TRUE(
+        nlohmann::json::parse(Slurp(other_run / "summary.json"))["two_view_bootstrap"].is_null())
+        << other;
   }
+  const fs::path bad_log = TestRoot() / "run_two_view_bad.log";
+  EXPECT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " +
+                      (TestRoot() / "run_two_view_bad").string() +
+                      " --set odometry.two_view_min_parallax_deg=0",
+                  bad_log),
+            2);
+  EXPECT_NE(Slurp(bad_log).find("two_view"), std::string::npos) << Slurp(bad_log);
 }
 
 TEST(RunCommandTest, UnknownConfigKeyIsAnError) {
