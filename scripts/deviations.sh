@@ -10,7 +10,7 @@
 # synthetic family at PLDVO_DEV_SEEDS, default "1 2 3", 640x480, and fr1/rpy and KITTI 00 when
 # present), PLDVO_DEV_FRAMES frames (default 300), PLDVO_DEV_FILTER an extended regex on the
 # sequence names. Both: PLDVO_DEV_REPEATS initial maps (default 3; mapping.init_seed 1..R),
-# inline mapping (deterministic), PLDVO_DEV_JOBS runs at a time. The full set is 36 configs x 35
+# inline mapping (deterministic), PLDVO_DEV_JOBS runs at a time. The full set is 34 configs x 35
 # sequences x R maps: a cluster job (docs/cluster.md; the grid's configs are in $dir/configs after
 # the first step).
 # Needs python3 with PyYAML (Debian: python3-yaml, which scripts/install_deps.sh installs) to
