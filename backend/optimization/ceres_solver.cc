@@ -52,6 +52,11 @@ SolverSummary CeresSolver::Solve(LeastSquaresProblem* problem,
   }
   ceres::Solver::Summary summary;
   ceres::Solve(options, ceres_problem.get(), &summary);
+  return SummarizeCeresSolve(summary);
+}
+
+SolverSummary SummarizeCeresSolve(const ceres::Solver::Summary& summary) {
+  SolverSummary result;
   // Ceres lists iteration 0 (the initial state) in summary.iterations.
   result.iterations = std::max(0, static_cast<int>(summary.iterations.size()) - 1);
   result.accepted_iterations = summary.num_successful_steps;

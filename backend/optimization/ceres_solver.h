@@ -6,9 +6,14 @@
 #ifndef PLDVO_BACKEND_OPTIMIZATION_CERES_SOLVER_H_
 #define PLDVO_BACKEND_OPTIMIZATION_CERES_SOLVER_H_
 
+#include <ceres/solver.h>
+
 #include "backend/optimization/solver.h"
 
 namespace pldvo {
+
+// Our summary of a ceres::Solve (iterations without Ceres' iteration 0, the initial state).
+SolverSummary SummarizeCeresSolve(const ceres::Solver::Summary& summary);
 
 class CeresSolver : public Solver {
  public:

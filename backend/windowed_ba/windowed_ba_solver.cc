@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "backend/optimization/bundle_adjustment_options.h"
+#include "backend/optimization/ceres_solver.h"
 #include "backend/optimization/gauss_newton_solver.h"
 #include "residuals/se3_manifold.h"
 
@@ -59,13 +60,7 @@ SolverSummary SolveWindowedBAProblem(const WindowedBAOptions& options, WindowedB
   const ceres::Solver::Options solver_options = MakeWindowedBACeresOptions(options, *problem);
   ceres::Solver::Summary ceres_summary;
   ceres::Solve(solver_options, ceres_problem.get(), &ceres_summary);
-  summary.iterations = std::max(0, static_cast<int>(ceres_summary.iterations.size()) - 1);
-  summary.accepted_iterations = ceres_summary.num_successful_steps;
-  summary.initial_cost = ceres_summary.initial_cost;
-  summary.final_cost = ceres_summary.final_cost;
-  summary.converged = ceres_summary.termination_type == ceres::CONVERGENCE;
-  summary.message = ceres_summary.message;
-  return summary;
+  return SummarizeCeresSolve(ceres_summary);
 }
 
 WindowedBAResult RunWindowedBA(const WindowedBAWindow& window, const WindowedBAOptions& options) {
