@@ -3,6 +3,7 @@
 // prepended "%YAML:1.0", and its errors come as cv::Exception (or std::length_error) to unpick.
 #include "core/yaml_reader.h"
 
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -11,10 +12,12 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
+#include <vector>
 
 namespace pldvo {
 namespace {
@@ -102,6 +105,37 @@ void RejectMultipleDocuments(const std::string& text, const std::string& path) {
   }
 }
 
+// Records where each document starts and nothing else.
+class DocumentStarts : public YAML::EventHandler {
+ public:
+  std::vector<YAML::Mark> marks;
+  void OnDocumentStart(const YAML::Mark& mark) override { marks.push_back(mark); }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                const std::string&) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {}
+  void OnMapEnd() override {}
+};
+
+// Where a second document starts, if the parser finds one. Asks for at most two documents:
+// yaml-cpp 0.7's LoadAll loops for ever on a document that starts with ',' (jbeder/yaml-cpp
+// #1040, fixed in 0.8), as its parser reports it again and again without consuming it.
+std::optional<YAML::Mark> SecondDocumentStart(const std::string& text) {
+  std::istringstream stream(text);
+  YAML::Parser parser(stream);
+  DocumentStarts starts;
+  for (int i = 0; i < 2 && parser.HandleNextDocument(starts); ++i) {
+  }
+  if (starts.marks.size() < 2) return std::nullopt;
+  return starts.marks[1];
+}
+
 // Every map key is a non-empty scalar, unique in its map.
 void CheckKeys(const YAML::Node& node, const std::string& key, const std::string& path,
                int* budget) {
@@ -146,18 +180,20 @@ YamlNode YamlNode::ReadFile(const std::string& path) {
   content << file.rdbuf();
   const std::string text = content.str();
   RejectMultipleDocuments(text, path);
-  std::vector<YAML::Node> documents;
+  YAML::Node document;
+  std::optional<YAML::Mark> second_document;
   try {
-    documents = YAML::LoadAll(text);
+    document = YAML::Load(text);
+    second_document = SecondDocumentStart(text);
   } catch (const YAML::ParserException& error) {  // also yaml-cpp's nesting limit
     FailAt(path, error.mark.line + 1, "YAML syntax error: " + error.msg);
   } catch (const std::exception& error) {
     FailAt(path, 0, std::string("YAML syntax error: ") + error.what());
   }
-  if (documents.size() > 1) {
-    FailAt(path, LineOf(documents[1]), "only one YAML document is supported");
+  if (second_document) {  // no second "---" (checked above): content the parser did not read
+    FailAt(path, second_document->line + 1, "YAML syntax error: content after the document");
   }
-  auto root = std::make_shared<YAML::Node>(documents.empty() ? YAML::Node() : documents[0]);
+  auto root = std::make_shared<YAML::Node>(document);
   int budget = kMaxNodes;
   CheckKeys(*root, "", path, &budget);
   return YamlNode(path, "", "", root, std::max(1, LineOf(*root)));

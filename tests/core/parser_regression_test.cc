@@ -89,6 +89,23 @@ TEST_F(ParserRegressionTest, YamlInputsThatHangOpenCvAreRejected) {
   }
 }
 
+// yaml-cpp 0.7's LoadAll looped for ever, allocating, on a document that starts with ','
+// (camera_yaml_fuzzer's input below, minimised; jbeder/yaml-cpp #1040). core/yaml_reader.cc asks
+// the parser for two documents at most and names the line of the content it could not read.
+TEST_F(ParserRegressionTest, YamlDocumentStartingWithACommaIsRejected) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {",", ":1: YAML syntax error"},
+      {"%YAML 1.2\n---\n,\n", ":3: YAML syntax error"},
+      {"%MALY:1.0\n,--\nmodel: fov\nwidth: 40\n", ":2: YAML syntax error"},
+  };
+  for (const auto& [text, what] : cases) {
+    const std::string path = Write("camera.yaml", text);
+    EXPECT_THAT(ErrorOf([&] { ReadCameraYaml(path); }), HasSubstr(path + what)) << text;
+    StringOptions options;
+    EXPECT_THAT(ErrorOf([&] { LoadConfigYaml(path, &options); }), HasSubstr(path + what)) << text;
+  }
+}
+
 TEST_F(ParserRegressionTest, YamlSpellingsNextToTheGuardStillRead) {
   for (const std::string& text :
        {std::string("%YAML:1.0\n---\n") + kCameraKeys,
