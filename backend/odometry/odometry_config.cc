@@ -39,6 +39,9 @@ std::string OdometryOptions::Check() const {
   if (!(two_view_min_parallax_deg > 0.0 && two_view_min_parallax_deg < 90.0)) {
     return "two_view_min_parallax_deg must be in (0, 90)";
   }
+  if (!(two_view_min_rotation_free_parallax_px >= 0.0)) {
+    return "two_view_min_rotation_free_parallax_px must be >= 0";
+  }
   if (two_view_min_inliers < 8) return "two_view_min_inliers must be >= 8";
   if (two_view_max_frames < 1) return "two_view_max_frames must be >= 1";
   return "";

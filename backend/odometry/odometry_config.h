@@ -138,14 +138,16 @@ struct OdometryOptions {
   double bootstrap_idepth_var = 0.05;
   // Two-view bootstrap (backend/odometry/two_view_bootstrap.h), monocular runs: frame 0's map from
   // the first frame k <= two_view_max_frames where two_view_min_inliers tracked corners triangulate
-  // (essential matrix) with a median parallax of two_view_min_parallax_deg, the poses of frames
-  // 1..k bundle-adjusted, and stereo with them; the run starts from it with bootstrap_idepth_var.
-  // Off by default (docs/bootstrap.md: where it succeeds at 640x480 the spread over initial maps
-  // collapses, but at 320x240 its map made every run fail); when it fails the run starts from the
-  // random map. bootstrap_passes > 1 and init_depth_idepth_var > 0 ask for another start and
-  // replace it.
-  bool two_view_bootstrap = false;
+  // (essential matrix) with a median parallax of two_view_min_parallax_deg and a median
+  // rotation-free parallax (the part of the corners' motion that no rotation explains) of
+  // two_view_min_rotation_free_parallax_px, the poses of frames 1..k bundle-adjusted, and stereo
+  // with them; the run starts from it with bootstrap_idepth_var.
+  // On by default (docs/bootstrap.md); when it fails (too few corners, too little parallax) the
+  // run starts from the random map, exactly as with it off. bootstrap_passes > 1 and
+  // init_depth_idepth_var > 0 ask for another start and replace it.
+  bool two_view_bootstrap = true;
   double two_view_min_parallax_deg = 2.0;
+  double two_view_min_rotation_free_parallax_px = 3.0;
   int two_view_min_inliers = 50;
   int two_view_max_frames = 60;
   // Solver comparison (docs/tracking.md): every tracked frame's final tracking problem (the same
@@ -205,10 +207,14 @@ struct OdometryOptions {
         "two_view_bootstrap", &two_view_bootstrap,
         "Monocular: frame 0's map from the two-view geometry of tracked corners and stereo "
         "with the frames up to the second view; the run starts from it unless bootstrap_passes > 1 "
-        "or init_depth_idepth_var > 0 asks for another start (default false).");
+        "or init_depth_idepth_var > 0 asks for another start (default true).");
     v.Field("two_view_min_parallax_deg", &two_view_min_parallax_deg,
             "Two-view bootstrap: median parallax of the triangulated corners that makes a frame "
             "the second view, deg (default 2).");
+    v.Field("two_view_min_rotation_free_parallax_px", &two_view_min_rotation_free_parallax_px,
+            "Two-view bootstrap: median angle between the corners' rays in the second view and "
+            "their rays in frame 0 turned by the best-fitting rotation, times the focal length, "
+            "px: below it the essential matrix is fitted to noise (default 3).");
     v.Field("two_view_min_inliers", &two_view_min_inliers,
             "Two-view bootstrap: triangulated essential-matrix inliers needed (default 50).");
     v.Field("two_view_max_frames", &two_view_max_frames,

@@ -173,13 +173,17 @@ InitialMap PrepareInitialMap(const Dataset& dataset, const OdometryConfig& confi
       const TwoViewBootstrap two_view = BootstrapFromTwoViews(dataset, config, num_frames);
       initial.depth = two_view.depth;
       initial.run_config.odometry.init_depth_idepth_var = config.odometry.bootstrap_idepth_var;
-      initial.two_view = {
-          {"second_view", two_view.second_view}, {"tracks", two_view.tracks},
-          {"inliers", two_view.inliers},         {"parallax_deg", two_view.parallax_deg},
-          {"points", two_view.points},           {"ms", two_view.ms}};
+      initial.two_view = {{"second_view", two_view.second_view},
+                          {"tracks", two_view.tracks},
+                          {"inliers", two_view.inliers},
+                          {"parallax_deg", two_view.parallax_deg},
+                          {"rotation_free_parallax_px", two_view.rotation_free_parallax_px},
+                          {"points", two_view.points},
+                          {"ms", two_view.ms}};
       std::cerr << "pldvo run: two-view bootstrap: second view frame " << two_view.second_view
                 << ", " << two_view.inliers << " of " << two_view.tracks
-                << " corners triangulated, median parallax " << two_view.parallax_deg << " deg, "
+                << " corners triangulated, median parallax " << two_view.parallax_deg
+                << " deg, rotation-free " << two_view.rotation_free_parallax_px << " px, "
                 << two_view.points << " hypotheses, " << static_cast<int>(two_view.ms) << " ms\n";
     } catch (const std::exception& e) {
       std::cerr << "pldvo run: " << e.what() << "; the run starts from the random map\n";

@@ -7,6 +7,7 @@
 #include <ceres/solver.h>
 
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
@@ -81,6 +82,7 @@ struct TwoViewGeometry {
   std::vector<int> track_ids;           // the inliers' indices into the tracks
   std::vector<Eigen::Vector3d> points;  // their triangulated positions
   double median_parallax_deg = 0.0;
+  double rotation_free_parallax_px = 0.0;
 };
 
 TwoViewGeometry EstimateTwoViewGeometry(const std::vector<Track>& tracks, const cv::Matx33d& K) {
@@ -114,6 +116,12 @@ TwoViewGeometry EstimateTwoViewGeometry(const std::vector<Track>& tracks, const 
     parallax_deg.push_back(std::acos(std::clamp(cos_angle, -1.0, 1.0)) * 180.0 / M_PI);
   }
   if (!parallax_deg.empty()) geometry.median_parallax_deg = Median(parallax_deg);
+  std::vector<cv::Point2f> inliers_0, inliers_k;
+  for (int i : geometry.track_ids) {
+    inliers_0.push_back(p0[i]);
+    inliers_k.push_back(pk[i]);
+  }
+  geometry.rotation_free_parallax_px = RotationFreeParallaxPx(inliers_0, inliers_k, K);
   return geometry;
 }
 
@@ -174,6 +182,33 @@ void BundleAdjust(const std::vector<Track>& tracks, const std::vector<int>& trac
 
 }  // namespace
 
+double RotationFreeParallaxPx(const std::vector<cv::Point2f>& x0,
+                              const std::vector<cv::Point2f>& xk, const cv::Matx33d& K) {
+  if (x0.size() != xk.size()) {
+    throw std::invalid_argument("RotationFreeParallaxPx: x0 and xk differ in size");
+  }
+  if (x0.size() < 3) return 0.0;
+  const auto ray = [&K](const cv::Point2f& x) {
+    return Eigen::Vector3d((x.x - K(0, 2)) / K(0, 0), (x.y - K(1, 2)) / K(1, 1), 1.0).normalized();
+  };
+  // Kabsch: the rotation R maximising sum ray_k^T R ray_0 is U diag(1, 1, det) V^T of the SVD of
+  // sum ray_k ray_0^T.
+  Eigen::Matrix3d correlation = Eigen::Matrix3d::Zero();
+  for (size_t i = 0; i < x0.size(); ++i) correlation += ray(xk[i]) * ray(x0[i]).transpose();
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(correlation,
+                                              Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d sign = Eigen::Matrix3d::Identity();
+  sign(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+  const Eigen::Matrix3d rotation = svd.matrixU() * sign * svd.matrixV().transpose();
+  const double focal_px = std::sqrt(K(0, 0) * K(1, 1));
+  std::vector<double> parallax_px;
+  for (size_t i = 0; i < x0.size(); ++i) {
+    const double cos_angle = ray(xk[i]).dot(rotation * ray(x0[i]));
+    parallax_px.push_back(focal_px * std::acos(std::clamp(cos_angle, -1.0, 1.0)));
+  }
+  return Median(parallax_px);
+}
+
 TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryConfig& config,
                                        int num_frames) {
   const auto start = WallClock::now();
@@ -196,9 +231,9 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
 
   TwoViewBootstrap result;
   TwoViewGeometry geometry;
-  // The frame with enough corners and the largest median parallax so far (error message).
+  // The frame with enough corners and the largest rotation-free parallax so far (error message).
   std::string best = "none";
-  double best_parallax_deg = -1.0;
+  double best_free_px = -1.0;
   for (int k = 1; k < last && result.second_view < 0; ++k) {
     images.push_back(dataset.Load(k).image);
     const cv::Mat next = ToGray8(images.back());
@@ -211,12 +246,14 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
     }
     geometry = EstimateTwoViewGeometry(tracks, K);
     const bool enough = static_cast<int>(geometry.points.size()) >= options.two_view_min_inliers;
-    if (enough && geometry.median_parallax_deg > best_parallax_deg) {
-      best_parallax_deg = geometry.median_parallax_deg;
+    if (enough && geometry.rotation_free_parallax_px > best_free_px) {
+      best_free_px = geometry.rotation_free_parallax_px;
       best = "frame " + std::to_string(k) + ": " + std::to_string(geometry.points.size()) +
-             " corners, " + std::to_string(best_parallax_deg) + " deg";
+             " corners, " + std::to_string(geometry.median_parallax_deg) + " deg, rotation-free " +
+             std::to_string(best_free_px) + " px";
     }
-    if (enough && geometry.median_parallax_deg >= options.two_view_min_parallax_deg) {
+    if (enough && geometry.median_parallax_deg >= options.two_view_min_parallax_deg &&
+        geometry.rotation_free_parallax_px >= options.two_view_min_rotation_free_parallax_px) {
       result.second_view = k;
     }
   }
@@ -225,11 +262,14 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
                              " has " + std::to_string(options.two_view_min_inliers) +
                              " corners triangulated with a median parallax of " +
                              std::to_string(options.two_view_min_parallax_deg) +
-                             " deg (largest with enough corners: " + best + ")");
+                             " deg and a rotation-free parallax of " +
+                             std::to_string(options.two_view_min_rotation_free_parallax_px) +
+                             " px (largest rotation-free with enough corners: " + best + ")");
   }
   result.tracks = static_cast<int>(tracks.size());
   result.inliers = static_cast<int>(geometry.points.size());
   result.parallax_deg = geometry.median_parallax_deg;
+  result.rotation_free_parallax_px = geometry.rotation_free_parallax_px;
 
   // Poses of frames 0..k (cam_from_ref) and corners, refined together over every frame.
   const int k = result.second_view;

@@ -11,7 +11,10 @@
 //   2. at every frame k, the essential matrix between frame 0 and k (five-point RANSAC) and its
 //      decomposition give (R, t) and triangulated corners; k is the second view when at least
 //      min_inliers corners are triangulated in front of both cameras with a median parallax
-//      angle of at least min_parallax_deg;
+//      angle of at least min_parallax_deg, and the corners moved by at least
+//      min_rotation_free_parallax_px (median) more than the best-fitting rotation explains: with
+//      less, the essential matrix fits the tracking noise and its decomposition can be any
+//      motion, while the triangulated parallax of that motion still looks large;
 //   3. the poses of frames 1..k and the corners are refined together over all their observations
 //      (bundle adjustment with Ceres, Huber loss; frame 0 fixed, |t_k| fixed), starting from
 //      poses interpolated between frame 0 and the two-view pose;
@@ -24,6 +27,7 @@
 #define PLDVO_BACKEND_ODOMETRY_TWO_VIEW_BOOTSTRAP_H_
 
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "backend/odometry/odometry_config.h"
 #include "core/dataset.h"
@@ -40,9 +44,21 @@ struct TwoViewBootstrap {
   int tracks = 0;             // corners tracked from frame 0 to k
   int inliers = 0;            // of which: essential-matrix inliers triangulated in front
   double parallax_deg = 0.0;  // their median parallax angle
-  int points = 0;             // observed hypotheses of frame 0's map
-  double ms = 0.0;            // wall time
+  double rotation_free_parallax_px = 0.0;  // their median parallax no rotation explains
+  int points = 0;                          // observed hypotheses of frame 0's map
+  double ms = 0.0;                         // wall time
 };
+
+// The parallax of the matched pixels x0[i] <-> xk[i] that no rotation explains, px: the median
+// angle between the rays of xk and the rays of x0 turned by the rotation that best aligns them
+// (Kabsch on unit rays), times the focal length sqrt(fx fy). Pure rotation gives 0 whatever the
+// essential matrix's decomposition says, and composing any rotation with the motion leaves it
+// unchanged; a translation t gives about |t| sin(angle to t) / depth per ray, minus what the best
+// rotation absorbs, so it bounds the translation's signal from below. Compared with the tracking
+// noise, it says whether an essential matrix fits the motion or the noise. 0 for fewer than 3
+// pairs; std::invalid_argument when the sizes differ.
+double RotationFreeParallaxPx(const std::vector<cv::Point2f>& x0,
+                              const std::vector<cv::Point2f>& xk, const cv::Matx33d& K);
 
 // Runs the two-view bootstrap over the first min(num_frames, two_view_max_frames) frames of
 // `dataset` with config.mapping. Throws std::runtime_error, saying why, when frame 0 cannot be

@@ -324,15 +324,16 @@ TEST(RunCommandTest, BootstrapRefinementRerunsTheFirstKeyframeFrames) {
 }
 
 // odometry.two_view_bootstrap: the run reports the second view and tracks every frame from frame
-// 0's bootstrapped map (1 deg of parallax: this sequence moves forward and does not reach the
-// default 2 deg in 36 frames); when the bootstrap fails (two frames, no parallax) the run starts
+// 0's bootstrapped map (gates lowered to 0.3 deg and 1 px: this sequence moves forward and reaches
+// neither default in 36 frames; TwoViewBootstrapTest checks the geometry); when the bootstrap fails (two frames, no parallax) the run starts
 // from the random map and says why; combinations with the other starts are config errors.
 TEST(RunCommandTest, TwoViewBootstrapStartsTheRunOrFallsBack) {
   const std::string kFlags = kDeterministic + std::string(" --max_frames 36");
   const fs::path run = TestRoot() / "run_two_view";
   ASSERT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " + run.string() + kFlags +
                       " --set odometry.two_view_bootstrap=true"
-                      " --set odometry.two_view_min_parallax_deg=1",
+                      " --set odometry.two_view_min_parallax_deg=0.3"
+                      " --set odometry.two_view_min_rotation_free_parallax_px=1",
                   TestRoot() / "run_two_view.log"),
             0)
       << Slurp(TestRoot() / "run_two_view.log");
@@ -342,7 +343,8 @@ TEST(RunCommandTest, TwoViewBootstrapStartsTheRunOrFallsBack) {
   std::printf("two-view bootstrap: %s\n", two_view.dump().c_str());
   EXPECT_GT(two_view["second_view"].get<int>(), 0);
   EXPECT_LT(two_view["second_view"].get<int>(), 36);
-  EXPECT_GE(two_view["parallax_deg"].get<double>(), 1.0);
+  EXPECT_GE(two_view["parallax_deg"].get<double>(), 0.3);
+  EXPECT_GE(two_view["rotation_free_parallax_px"].get<double>(), 1.0);
   EXPECT_GT(two_view["points"].get<int>(), 1000);
   EXPECT_EQ(summary["tracked"].get<int>(), 36);
 

@@ -61,6 +61,7 @@ void ExpectExtras(const OdometryConfig& config, bool on, const std::string& name
   EXPECT_EQ(config.odometry.line_prior_gate_px, on ? 2.0 : 0.0);
   EXPECT_EQ(config.odometry.line_outlier_px, on ? 2.0 : 0.0);
   EXPECT_EQ(config.odometry.try_alternatives, on);
+  EXPECT_EQ(config.odometry.two_view_bootstrap, on);
 }
 
 // Per shipped file: what its header comment says it turns on.
@@ -95,6 +96,7 @@ const std::map<std::string, std::function<void(const OdometryConfig&)>>& Cases()
          EXPECT_FALSE(c.odometry.use_lines);
          EXPECT_FALSE(c.mapping.use_line_stereo);
          EXPECT_FALSE(c.mapping.line_regularization);
+         EXPECT_TRUE(c.odometry.two_view_bootstrap);  // the same start as points_lines
        }},
       {"lines_only",
        [](const OdometryConfig& c) {
