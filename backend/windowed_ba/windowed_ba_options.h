@@ -1,7 +1,8 @@
 // Options of windowed photometric + line bundle adjustment (docs/windowed_ba.md). One typed
 // struct: read from YAML and `--set` through VisitFields (core/config_io.h, unknown keys are
-// errors), validated by Check(). Not yet a section of the odometry's config: the BA does not run
-// in the odometry loop yet (docs/windowed_ba.md, "Not done yet").
+// errors), validated by Check(). The odometry's config holds it as `backend.windowed_ba`
+// (backend/odometry/odometry_config.h); the odometry runs it when `enabled` (docs/windowed_ba.md,
+// "In the odometry").
 #ifndef PLDVO_BACKEND_WINDOWED_BA_WINDOWED_BA_OPTIONS_H_
 #define PLDVO_BACKEND_WINDOWED_BA_WINDOWED_BA_OPTIONS_H_
 
@@ -36,6 +37,8 @@ inline const ChoiceNames<WindowedBASolver>& WindowedBASolverNames() {
 using WindowedBALinearSolver = BALinearSolver;
 
 struct WindowedBAOptions {
+  // Off by default: the odometry runs without the windowed BA unless asked.
+  bool enabled = false;
   // The registered problem builder (WindowedBAProblemBuilderRegistry): "windowed_ba" (robust
   // loss row-wise inside the cost functions) or "windowed_ba_ceres_loss" (the loss given to the
   // problem per residual block, i.e. per point pattern and target).
@@ -85,9 +88,15 @@ struct WindowedBAOptions {
   int max_iterations = 20;
   double function_tolerance = 1e-6;
   int num_threads = 1;
+  // Windows waiting in WindowedBundleAdjuster's queue (odometry with the mapping thread); a new
+  // one beyond this drops the oldest pending one (a newer window supersedes it).
+  int max_queue = 2;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
+    v.Field("enabled", &enabled,
+            "Run windowed photometric + line bundle adjustment over the newest keyframes "
+            "beside tracking (default false).");
     v.Field("problem_builder", &problem_builder,
             "Registered windowed BA problem builder: windowed_ba (row-wise loss) or "
             "windowed_ba_ceres_loss (loss per residual block).");
@@ -118,6 +127,8 @@ struct WindowedBAOptions {
     v.Field("max_iterations", &max_iterations, "Iterations per window.");
     v.Field("function_tolerance", &function_tolerance, "Relative cost-change tolerance.");
     v.Field("num_threads", &num_threads, "Ceres threads per solve.");
+    v.Field("max_queue", &max_queue,
+            "Pending windows in the worker's queue (oldest dropped; default 2).");
   }
   // "" when valid, otherwise what is wrong (names the key; an unknown problem_builder lists the
   // registered ones).
