@@ -91,6 +91,13 @@ struct WindowedBAOptions {
   // Windows waiting in WindowedBundleAdjuster's queue (odometry with the mapping thread); a new
   // one beyond this drops the oldest pending one (a newer window supersedes it).
   int max_queue = 2;
+  // Odometry: the current keyframe's depth-filter hypotheses are shifted by the optimised
+  // points' corrections (DepthMapper::ApplyIdepthCorrections); false: poses only.
+  bool depth_feedback = true;
+  // ... and with depth_feedback, the current keyframe's other hypotheses re-expressed in its frame
+  // as the BA moved it relative to the keyframe its map was propagated from (off: only the
+  // optimised points change; docs/windowed_ba.md compares the two).
+  bool warp_current_map = false;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
@@ -129,6 +136,12 @@ struct WindowedBAOptions {
     v.Field("num_threads", &num_threads, "Ceres threads per solve.");
     v.Field("max_queue", &max_queue,
             "Pending windows in the worker's queue (oldest dropped; default 2).");
+    v.Field("depth_feedback", &depth_feedback,
+            "Shift the current keyframe's depth-filter hypotheses by the optimised points' "
+            "corrections (default true); false: poses only.");
+    v.Field("warp_current_map", &warp_current_map,
+            "depth_feedback: also re-express the current keyframe's other hypotheses in its "
+            "frame as moved by the BA relative to its propagation source (default false).");
   }
   // "" when valid, otherwise what is wrong (names the key; an unknown problem_builder lists the
   // registered ones).
