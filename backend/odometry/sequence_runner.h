@@ -16,7 +16,9 @@
 //   OUT/keyframes_ba.txt with backend.windowed_ba: every keyframe's pose after the last BA window
 //                        that held it, TUM format, written at the end (summary.json
 //                        `windowed_ba`). trajectory.txt keeps each frame as it was output: tracked
-//                        against its keyframe as refined by the windows applied up to then.
+//                        against its keyframe as refined by the windows applied up to then;
+//   OUT/trajectory_ba.txt with backend.windowed_ba: every tracked frame re-anchored to its
+//                        keyframe's final pose (world_from_kf_final * kf_from_cam), at the end.
 // A frame that fails to load is reported with its file, marked failed and skipped.
 #ifndef PLDVO_BACKEND_ODOMETRY_SEQUENCE_RUNNER_H_
 #define PLDVO_BACKEND_ODOMETRY_SEQUENCE_RUNNER_H_
