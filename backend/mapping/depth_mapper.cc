@@ -278,6 +278,38 @@ LineDepthFusionStats DepthMapper::FuseLineDepths(const std::vector<KeyframeLine>
   return stats;
 }
 
+int DepthMapper::ApplyIdepthCorrections(const std::vector<IdepthCorrection>& corrections,
+                                        const SE3* new_from_old) {
+  int applied = 0;
+  std::vector<char> corrected(map_.num_pixels(), 0);
+  for (const IdepthCorrection& correction : corrections) {
+    const int i = correction.pixel_index;
+    if (i < 0 || i >= map_.num_pixels() || !map_.valid(i)) continue;
+    corrected[i] = 1;
+    const double idepth = map_.idepth(i) + correction.delta_idepth;
+    if (!(idepth > 0.0) || !(idepth <= options_.max_idepth)) continue;
+    map_.SetIdepth(i, idepth);
+    ++applied;
+  }
+  if (new_from_old == nullptr) return applied;
+  const Eigen::Matrix3d rotation = new_from_old->rotation_matrix();
+  const Eigen::Vector3d translation = new_from_old->translation();
+  for (int i = 0; i < map_.num_pixels(); ++i) {
+    if (corrected[i] || !map_.valid(i)) continue;
+    const double idepth = map_.idepth(i);
+    const Eigen::Vector2d pixel(i % map_.width(), i / map_.width());
+    const double c = rotation.row(2).dot(camera_.Unproject(pixel));
+    const double denominator = c + translation.z() * idepth;
+    if (!(denominator > 0.0)) continue;
+    const double moved = idepth / denominator;
+    if (!(moved > 0.0) || !(moved <= options_.max_idepth)) continue;
+    const double jacobian = c / (denominator * denominator);
+    map_.SetIdepthAndVar(i, moved, jacobian * jacobian * map_.idepth_var(i));
+    ++applied;
+  }
+  return applied;
+}
+
 SemiDenseDepthMap DepthMapper::RegularizedMap(bool smooth, bool line_regularize,
                                               LineRegularizationStats* stats) const {
   SemiDenseDepthMap result;

@@ -72,6 +72,12 @@ struct LineDepthFusionStats {
   int outliers = 0;  // rejected by the EKF gate
 };
 
+// A correction of one hypothesis' inverse depth (ApplyIdepthCorrections).
+struct IdepthCorrection {
+  int pixel_index = -1;       // y * width + x
+  double delta_idepth = 0.0;  // added to the mean, 1/m
+};
+
 class DepthMapper {
  public:
   // Throws std::invalid_argument when the camera or options are invalid.
@@ -102,6 +108,20 @@ class DepthMapper {
   // pixels lie up to 1.5 px off their keyframe line.
   static constexpr double kLineDepthMissPx = 2.0;
   LineDepthFusionStats FuseLineDepths(const std::vector<KeyframeLine>& lines);
+
+  // The windowed BA's feedback into the keyframe's hypotheses (docs/windowed_ba.md):
+  // - each hypothesis with a correction: its mean shifted by it (the BA's refined minus submitted
+  //   inverse depth), the variance kept (the BA's posterior variance is not computed; keeping the
+  //   filter's is conservative);
+  // - with `new_from_old` (the keyframe's frame moved relative to the keyframe its map was
+  //   propagated from), every other valid hypothesis re-expressed in the moved frame at its pixel:
+  //   with r = K^-1 (x; 1) and c = (R r)_z, the point r / d becomes R r / d + t, so
+  //   d' = d / (c + t_z d) and V' = (c / (c + t_z d)^2)^2 V (first order); the pixel's shift,
+  //   below a pixel for the small corrections of a window, is not applied.
+  // A result that is non-positive, above options.max_idepth or on an invalid pixel is skipped.
+  // Returns the number of hypotheses changed.
+  int ApplyIdepthCorrections(const std::vector<IdepthCorrection>& corrections,
+                             const SE3* new_from_old = nullptr);
 
   // A copy of the filter state with inverse-variance smoothing (if smooth) and the 3D line
   // regularisation of the keyframe's edges (if line_regularize).

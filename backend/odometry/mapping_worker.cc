@@ -137,6 +137,11 @@ int MappingWorker::line_depth_outliers() const {
   return line_depth_outliers_;
 }
 
+int MappingWorker::idepth_corrections_applied() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return idepth_corrections_applied_;
+}
+
 void MappingWorker::ThreadLoop() {
   while (true) {
     MappingJob job;
@@ -193,12 +198,22 @@ void MappingWorker::Run(const MappingJob& job) {
                                 job.lines_in_cur, job.pose_covariance);
         ++num_updates_;
         break;
-      case MappingJob::Kind::kLineDepths: {
+      case MappingJob::Kind::kLineDepths:
+      case MappingJob::Kind::kIdepthCorrections: {
         if (job.keyframe_id != keyframe_id_) return;  // for a keyframe no longer current
-        const LineDepthFusionStats stats = mapper_.FuseLineDepths(job.line_depths);
+        int fused = 0, outliers = 0, corrected = 0;
+        if (job.kind == MappingJob::Kind::kLineDepths) {
+          const LineDepthFusionStats stats = mapper_.FuseLineDepths(job.line_depths);
+          fused = stats.fused;
+          outliers = stats.outliers;
+        } else {
+          corrected = mapper_.ApplyIdepthCorrections(
+              job.idepth_corrections, job.move_keyframe ? &job.new_from_old : nullptr);
+        }
         std::lock_guard<std::mutex> lock(mutex_);
-        line_depths_fused_ += stats.fused;
-        line_depth_outliers_ += stats.outliers;
+        line_depths_fused_ += fused;
+        line_depth_outliers_ += outliers;
+        idepth_corrections_applied_ += corrected;
         // Often published right after the keyframe switch, before the odometry has read it: keep
         // what the switch reported (retired map, propagation, random init).
         if (latest_ != nullptr && latest_->keyframe_id == keyframe_id_) {

@@ -1,14 +1,15 @@
 // The mapping side of the odometry: a DepthMapper (semi-dense keyframe depth filter) fed with
 // jobs (initialise a keyframe, fuse a tracked frame, switch to a new keyframe, fuse the edge BA's
-// optimised lines, DepthMapper::FuseLineDepths), run either in its own thread (parallel) or
+// optimised lines, DepthMapper::FuseLineDepths, shift depths by the windowed BA's corrections,
+// DepthMapper::ApplyIdepthCorrections), run either in its own thread (parallel) or
 // inline on the caller's thread (deterministic). After every job the worker publishes an
 // immutable KeyframeMap: the regularised map and the tracking reference points built from it
 // (reference_builder.h), which the tracking thread picks up without copying the filter state.
 //
 // Ordering: jobs run in submission order. When more than `max_pending_updates` frame updates wait
 // in parallel mode, the oldest waiting update is dropped (counted in dropped_updates()); keyframe
-// and line-depth jobs are never dropped. Inline, frame updates can be held back by `inline_lag`
-// later submissions (the lag of a mapping thread, deterministically).
+// and line-depth / depth-correction jobs are never dropped. Inline, frame updates can be held back
+// by `inline_lag` later submissions (the lag of a mapping thread, deterministically).
 #ifndef PLDVO_BACKEND_ODOMETRY_MAPPING_WORKER_H_
 #define PLDVO_BACKEND_ODOMETRY_MAPPING_WORKER_H_
 
@@ -48,7 +49,7 @@ struct KeyframeMap {
 };
 
 struct MappingJob {
-  enum class Kind { kInitialize, kUpdate, kNewKeyframe, kLineDepths };
+  enum class Kind { kInitialize, kUpdate, kNewKeyframe, kLineDepths, kIdepthCorrections };
   Kind kind = Kind::kUpdate;
   int keyframe_id = -1;  // the keyframe the job concerns (the new one for kNewKeyframe)
   int frame_index = -1;
@@ -78,6 +79,12 @@ struct MappingJob {
   // kLineDepths: the edge BA's optimised lines observed by keyframe_id, in its camera frame
   // (DepthMapper::FuseLineDepths); ignored when keyframe_id is no longer current.
   std::vector<KeyframeLine> line_depths;
+  // kIdepthCorrections: the windowed BA's inverse-depth corrections of keyframe_id's hypotheses
+  // and, with move_keyframe, new_from_old is the keyframe's frame moved relative to the keyframe
+  // it was propagated from (DepthMapper::ApplyIdepthCorrections); ignored when keyframe_id is no
+  // longer current.
+  std::vector<IdepthCorrection> idepth_corrections;
+  bool move_keyframe = false;
 };
 
 class MappingWorker {
@@ -113,6 +120,8 @@ class MappingWorker {
   // Sum of LineDepthFusionStats::fused / ::outliers over every kLineDepths job.
   int line_depths_fused() const;
   int line_depth_outliers() const;
+  // Sum of DepthMapper::ApplyIdepthCorrections over every kIdepthCorrections job.
+  int idepth_corrections_applied() const;
 
  private:
   void Run(const MappingJob& job);
@@ -145,6 +154,7 @@ class MappingWorker {
   int failed_jobs_ = 0;
   int line_depths_fused_ = 0;
   int line_depth_outliers_ = 0;
+  int idepth_corrections_applied_ = 0;
   int failed_keyframe_id_ = -1;
   std::thread thread_;
 };

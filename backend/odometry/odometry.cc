@@ -1,5 +1,7 @@
 #include "backend/odometry/odometry.h"
 
+#include <glog/logging.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -97,6 +99,13 @@ Odometry::Odometry(const PinholeCamera& camera, const OdometryConfig& config,
       edge_ba_adjuster_ = std::make_unique<EdgeBundleAdjuster>(edge_ba);
     }
   }
+  const WindowedBAOptions& windowed_ba = config_.backend.windowed_ba;
+  if (windowed_ba.enabled) {
+    windowed_ba_keyframes_ = std::make_unique<WindowedBAKeyframes>(camera_, windowed_ba.window);
+    if (config_.odometry.parallel_mapping) {
+      windowed_ba_adjuster_ = std::make_unique<WindowedBundleAdjuster>(windowed_ba);
+    }
+  }
 }
 
 Odometry::~Odometry() = default;
@@ -107,6 +116,7 @@ OdometryStatistics Odometry::statistics() const {
   stats.failed_mapping_jobs = mapper_->failed_jobs();
   stats.edge_ba_line_depths_fused = mapper_->line_depths_fused();
   stats.edge_ba_line_depth_outliers = mapper_->line_depth_outliers();
+  stats.windowed_ba_idepths_corrected = mapper_->idepth_corrections_applied();
   return stats;
 }
 
@@ -221,7 +231,9 @@ void Odometry::StartKeyframe(int index, double timestamp, const cv::Mat& image, 
     job.depth_idepth_var = config_.odometry.init_depth_idepth_var;
   }
   const bool want_maps = observer_ != nullptr && observer_->WantsKeyframeMaps();
-  job.keep_retired_map = want_maps && !initialize;
+  // The windowed BA records the retired keyframe's final map too.
+  job.keep_retired_map = (want_maps || windowed_ba_keyframes_ != nullptr) && !initialize;
+  const AffineBrightness brightness_from_previous = job.brightness;
   if (frontend_ != nullptr && !lines.segments.empty()) {
     // Every keyframe segment is traced: its pixels get an edge id in the map, and whichever of
     // them a later frame matches gives point-to-line residuals and line-guided stereo.
@@ -231,7 +243,7 @@ void Odometry::StartKeyframe(int index, double timestamp, const cv::Mat& image, 
     job.edges = frontend_->TraceMatched(lines, all, &trace_timing);
     timing->tracing_ms += trace_timing.tracing_ms;
   }
-  if (job.keep_retired_map) retiring_ = keyframe_;
+  if (want_maps && !initialize) retiring_ = keyframe_;
   keyframe_ = ActiveKeyframe();
   keyframe_.id = job.keyframe_id;
   keyframe_.frame_index = index;
@@ -244,6 +256,104 @@ void Odometry::StartKeyframe(int index, double timestamp, const cv::Mat& image, 
   const EdgeTrace edges = edge_ba_window_ != nullptr ? job.edges : EdgeTrace();
   mapper_->Submit(std::move(job));
   if (edge_ba_window_ != nullptr) UpdateEdgeBA(edges, previous_segment, new_from_old.Inverse());
+  if (windowed_ba_keyframes_ != nullptr) {
+    // Not associated with the previous keyframe (first keyframe, re-initialisation at an
+    // extrapolated pose): the window restarts with this keyframe.
+    if (previous_segment == nullptr) windowed_ba_keyframes_->Clear();
+    windowed_ba_keyframes_->AddKeyframe(
+        keyframe_.id, index, timestamp, keyframe_.world_from_kf, image, keyframe_.lines.segments,
+        previous_segment != nullptr ? *previous_segment : std::vector<int>(),
+        brightness_from_previous);
+  }
+}
+
+void Odometry::UpdateWindowedBA(const KeyframeMap& map) {
+  if (map.retired_map != nullptr) {
+    windowed_ba_keyframes_->SetPoints(map.retired_keyframe_id, *map.retired_map);
+  }
+  if (map.map == nullptr || map.keyframe_id != keyframe_.id ||
+      !windowed_ba_keyframes_->SetPoints(map.keyframe_id, *map.map) ||
+      !windowed_ba_keyframes_->Ready()) {
+    return;
+  }
+  WindowedBAWindow window = windowed_ba_keyframes_->MakeWindow();
+  try {
+    if (windowed_ba_adjuster_ != nullptr) {
+      // Remember reads the ids and poses only; the adjuster gets the points.
+      WindowedBAWindow submitted;
+      for (const WindowedBAKeyframe& k : window.keyframes) {
+        submitted.keyframes.push_back({k.id, k.cam_from_world, k.brightness, nullptr, {}, {}});
+      }
+      windowed_ba_keyframes_->Remember(windowed_ba_adjuster_->Submit(std::move(window)), submitted);
+      return;
+    }
+    windowed_ba_keyframes_->Remember(-1, window);
+    ApplyWindowedBA(RunWindowedBA(window, config_.backend.windowed_ba));  // sequence -1
+  } catch (const std::exception& e) {
+    // A malformed window (CheckWindowedBAWindow) or a failed build: the run goes on without it.
+    LOG(WARNING) << "windowed BA at keyframe " << keyframe_.id << " failed: " << e.what();
+    ++stats_.windowed_ba_failures;
+  }
+}
+
+void Odometry::PollWindowedBA() {
+  if (windowed_ba_adjuster_ == nullptr) return;
+  while (std::optional<WindowedBAResult> result = windowed_ba_adjuster_->Poll()) {
+    ApplyWindowedBA(*result);
+  }
+}
+
+void Odometry::ApplyWindowedBA(const WindowedBAResult& result) {
+  ++stats_.windowed_ba_windows;
+  windowed_ba_times_ms_.push_back(1e3 * (result.build_seconds + result.solve_seconds));
+  windowed_ba_points_.push_back(static_cast<double>(result.points.size()));
+  windowed_ba_iterations_.push_back(result.summary.iterations);
+  // The current keyframe relative to the keyframe its map was propagated from, before the result.
+  SE3 world_from_previous;
+  const bool has_previous =
+      windowed_ba_keyframes_->WorldFromPreviousKeyframe(keyframe_.id, &world_from_previous);
+  const SE3 kf_from_previous_before = keyframe_.world_from_kf.Inverse() * world_from_previous;
+  std::vector<IdepthCorrection> corrections;
+  if (!windowed_ba_keyframes_->Apply(result, keyframe_.id, &corrections)) return;
+  ++stats_.windowed_ba_applied;
+  // The current keyframe's refined pose; the last good frame was tracked against it (or is it),
+  // so it moves rigidly with it (re-anchored) and the motion model (relative) stays valid.
+  SE3 world_from_kf;
+  if (windowed_ba_keyframes_->WorldFromKeyframe(keyframe_.id, &world_from_kf)) {
+    world_from_last_good_ =
+        world_from_kf * keyframe_.world_from_kf.Inverse() * world_from_last_good_;
+    keyframe_.world_from_kf = world_from_kf;
+  }
+  if (retiring_.id >= 0) {
+    windowed_ba_keyframes_->WorldFromKeyframe(retiring_.id, &retiring_.world_from_kf);
+  }
+  if (!config_.backend.windowed_ba.depth_feedback) return;
+  // The current keyframe's hypotheses (the mapping thread ignores the job once the keyframe is
+  // no longer current): the optimised points' corrections and, with warp_current_map, the others
+  // re-expressed in the keyframe's frame as moved relative to the keyframe its map was propagated
+  // from (tracking of the next frames uses the whole map with the moved pose).
+  MappingJob job;
+  job.kind = MappingJob::Kind::kIdepthCorrections;
+  job.keyframe_id = keyframe_.id;
+  job.frame_index = keyframe_.frame_index;
+  job.idepth_corrections = std::move(corrections);
+  if (has_previous && config_.backend.windowed_ba.warp_current_map &&
+      windowed_ba_keyframes_->WorldFromPreviousKeyframe(keyframe_.id, &world_from_previous)) {
+    const SE3 kf_from_previous_after = keyframe_.world_from_kf.Inverse() * world_from_previous;
+    job.move_keyframe = true;
+    job.new_from_old = kf_from_previous_after * kf_from_previous_before.Inverse();
+  }
+  if (job.idepth_corrections.empty() && !job.move_keyframe) return;
+  ++stats_.windowed_ba_idepth_jobs;
+  mapper_->Submit(std::move(job));
+}
+
+std::vector<KeyframePoseRecord> Odometry::WindowedBAKeyframePoses() const {
+  if (windowed_ba_keyframes_ == nullptr) return {};
+  std::vector<KeyframePoseRecord> poses = windowed_ba_keyframes_->Departed();
+  const std::vector<KeyframePoseRecord> recorded = windowed_ba_keyframes_->Recorded();
+  poses.insert(poses.end(), recorded.begin(), recorded.end());
+  return poses;
 }
 
 void Odometry::UpdateEdgeBA(const EdgeTrace& edges, const std::vector<int>* previous_segment,
@@ -355,6 +465,14 @@ void Odometry::RefreshMap(OdometryTiming* timing) {
     if (map_ != nullptr) {
       NotifyRetired(*map_);
       NoteKeyframeMap(*map_);
+      if (windowed_ba_keyframes_ != nullptr) {
+        UpdateWindowedBA(*map_);
+        // Synchronous: the depth corrections of the current keyframe are already published.
+        if (windowed_ba_adjuster_ == nullptr) {
+          const std::shared_ptr<const KeyframeMap> latest = mapper_->Latest();
+          if (latest != nullptr && latest->keyframe_id == map_->keyframe_id) map_ = latest;
+        }
+      }
     }
   } else {
     map_ = mapper_->Latest();
@@ -409,6 +527,7 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, PreparedFrame
     return result;
   }
   PollEdgeBA();
+  PollWindowedBA();
   RefreshMap(&timing);
   result.keyframe_id = keyframe_.id;
   const SE3 world_from_prior = PredictWorldFromCam(index);
@@ -631,6 +750,10 @@ void Odometry::Finish() {
   if (edge_ba_adjuster_ != nullptr) {
     edge_ba_adjuster_->WaitIdle();
     PollEdgeBA();
+  }
+  if (windowed_ba_adjuster_ != nullptr) {
+    windowed_ba_adjuster_->WaitIdle();
+    PollWindowedBA();
   }
   if (observer_ == nullptr || !observer_->WantsKeyframeMaps() || keyframe_.id < 0) return;
   const std::shared_ptr<const KeyframeMap> map = mapper_->Latest();

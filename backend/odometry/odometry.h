@@ -25,6 +25,13 @@
 // world_from_kf, and with it the current keyframe and the motion model; with
 // backend.edge_ba.line_depth_feedback, the optimised lines the current keyframe observes go to
 // the mapping thread and are fused into its depth map (docs/edge_ba.md).
+// With backend.windowed_ba.enabled, every keyframe is recorded (WindowedBAKeyframes) and, when the
+// mapping thread has published a new keyframe's first map (with the previous keyframe's final
+// one), the newest keyframes are submitted to windowed photometric + line bundle adjustment: on
+// WindowedBundleAdjuster's worker thread, polled at the start of every frame, or synchronously
+// when odometry.parallel_mapping is false (deterministic). A result moves the window keyframes'
+// world_from_kf, the current keyframe and the motion model with them, and shifts the current
+// keyframe's depth-filter hypotheses by the optimised points' corrections (docs/windowed_ba.md).
 #ifndef PLDVO_BACKEND_ODOMETRY_ODOMETRY_H_
 #define PLDVO_BACKEND_ODOMETRY_ODOMETRY_H_
 
@@ -39,8 +46,10 @@
 #include "backend/odometry/odometry_config.h"
 #include "backend/odometry/odometry_observer.h"
 #include "backend/odometry/retry_trigger.h"
+#include "backend/odometry/windowed_ba_keyframes.h"
 #include "backend/tracking/photometric_consensus.h"
 #include "backend/tracking/tracker.h"
+#include "backend/windowed_ba/windowed_ba_adjuster.h"
 #include "core/image_pyramid.h"
 #include "core/pinhole_camera.h"
 #include "core/se3.h"
@@ -73,6 +82,13 @@ struct OdometryStatistics {
   int edge_ba_line_depths_fused = 0;
   int edge_ba_line_depth_outliers = 0;
   int line_term_drops = 0;  // frames whose line term the consensus check dropped
+  // backend.windowed_ba: windows solved, applied (moved the keyframe poses), solves that threw,
+  // depth-correction jobs sent to the mapping thread and the hypotheses they shifted.
+  int windowed_ba_windows = 0;
+  int windowed_ba_applied = 0;
+  int windowed_ba_failures = 0;
+  int windowed_ba_idepth_jobs = 0;
+  int windowed_ba_idepths_corrected = 0;
 };
 
 class Odometry {
@@ -108,6 +124,14 @@ class Odometry {
   const std::vector<double>& EdgeBAWindowTimesMs() const { return edge_ba_times_ms_; }
   // Wall time of the line covariances of every window that computed them (ms).
   const std::vector<double>& EdgeBACovarianceTimesMs() const { return edge_ba_covariance_ms_; }
+  // Per solved windowed BA window: wall time (problem build + solve on the solving thread, ms),
+  // points in the problem and solver iterations.
+  const std::vector<double>& WindowedBATimesMs() const { return windowed_ba_times_ms_; }
+  const std::vector<double>& WindowedBAPoints() const { return windowed_ba_points_; }
+  const std::vector<double>& WindowedBAIterations() const { return windowed_ba_iterations_; }
+  // backend.windowed_ba: every keyframe's pose after the last applied window that held it (or as
+  // tracked), oldest first; empty without the windowed BA. Complete after Finish().
+  std::vector<KeyframePoseRecord> WindowedBAKeyframePoses() const;
   const OdometryConfig& config() const { return config_; }
 
  private:
@@ -186,6 +210,11 @@ class Odometry {
   // backend.edge_ba.line_depth_feedback: a kLineDepths job with the result's optimised lines
   // that the current keyframe observes (counts a failed covariance instead).
   void SendLineDepths(const EdgeBAResult& result);
+  // Windowed BA: records the published maps of `map` (the current keyframe's, and the retired
+  // keyframe's final one) and, when the window is ready, solves it (synchronous) or submits it.
+  void UpdateWindowedBA(const KeyframeMap& map);
+  void PollWindowedBA();
+  void ApplyWindowedBA(const WindowedBAResult& result);
   void NotifyRetired(const KeyframeMap& map);
   // A new keyframe's first published map: a fresh random map on a re-initialisation keyframe
   // loses the scale (scale_lost_).
@@ -207,6 +236,12 @@ class Odometry {
   std::unique_ptr<EdgeBundleAdjuster> edge_ba_adjuster_;
   std::vector<double> edge_ba_times_ms_;
   std::vector<double> edge_ba_covariance_ms_;
+  // Windowed BA (null when disabled); the adjuster only in parallel mode.
+  std::unique_ptr<WindowedBAKeyframes> windowed_ba_keyframes_;
+  std::unique_ptr<WindowedBundleAdjuster> windowed_ba_adjuster_;
+  std::vector<double> windowed_ba_times_ms_;
+  std::vector<double> windowed_ba_points_;
+  std::vector<double> windowed_ba_iterations_;
 
   bool initialized_ = false;
   int next_keyframe_id_ = 0;

@@ -54,6 +54,17 @@ std::string OutputOptions::Check() const {
   return "";
 }
 
+std::string BackendOptions::Check() const {
+  const std::string edge_error = edge_ba.Check();
+  if (!edge_error.empty()) return "edge_ba: " + edge_error;
+  const std::string windowed_error = windowed_ba.Check();
+  if (!windowed_error.empty()) return "windowed_ba: " + windowed_error;
+  if (edge_ba.enabled && windowed_ba.enabled) {
+    return "edge_ba and windowed_ba cannot both be enabled (both move the keyframe poses)";
+  }
+  return "";
+}
+
 std::string OdometryConfig::Check() const {
   const std::pair<const char*, std::string> sections[] = {
       {"dataset", dataset.Check()},     {"lines", lines.Check()},

@@ -10,7 +10,8 @@
 //   odometry   OdometryOptions (pyramid, line frontend on/off, alternative initial guesses,
 //              lost-tracking recovery, threading)
 //   output     OutputOptions (iteration images, keyframe depth PNGs, PLY point clouds)
-//   backend    BackendOptions: edge_ba = EdgeBAOptions (windowed edge bundle adjustment)
+//   backend    BackendOptions: edge_ba = EdgeBAOptions (windowed edge bundle adjustment),
+//              windowed_ba = WindowedBAOptions (windowed photometric + line bundle adjustment)
 // Defaults are experiments/configs/points_lines.yaml (it names no key whose value differs): the
 // paper's method with this implementation's extras, which experiments/configs/paper.yaml switches
 // off (docs/deviations.md); docs/config_keys.md lists every key.
@@ -22,6 +23,7 @@
 #include "backend/edge_ba/edge_ba_options.h"
 #include "backend/mapping/mapping_options.h"
 #include "backend/tracking/tracker.h"
+#include "backend/windowed_ba/windowed_ba_options.h"
 #include "core/dataset.h"
 #include "core/options.h"
 #include "frontend/line_frontend_options.h"
@@ -269,15 +271,19 @@ struct OutputOptions {
   std::string Check() const;
 };
 
-// Optimisation beside tracking (docs/edge_ba.md).
+// Optimisation beside tracking (docs/edge_ba.md, docs/windowed_ba.md). At most one of the two
+// runs: both move the same keyframe poses.
 struct BackendOptions {
-  EdgeBAOptions edge_ba;  // off by default
+  EdgeBAOptions edge_ba;          // off by default
+  WindowedBAOptions windowed_ba;  // off by default
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
     v.Section("edge_ba", &edge_ba, "Windowed edge bundle adjustment over the newest keyframes.");
+    v.Section("windowed_ba", &windowed_ba,
+              "Windowed photometric + line bundle adjustment over the newest keyframes.");
   }
-  std::string Check() const { return edge_ba.Check(); }
+  std::string Check() const;
 };
 
 struct OdometryConfig {
@@ -303,7 +309,8 @@ struct OdometryConfig {
     v.Section("keyframes", &keyframes, "Keyframe selection.");
     v.Section("odometry", &odometry, "Pipeline, lost-tracking recovery and threading.");
     v.Section("output", &output, "Optional outputs of `pldvo run`.");
-    v.Section("backend", &backend, "Optimisation beside tracking (edge bundle adjustment).");
+    v.Section("backend", &backend,
+              "Optimisation beside tracking (edge or photometric windowed bundle adjustment).");
   }
   // "" when valid, otherwise the first section and what is wrong there.
   std::string Check() const;

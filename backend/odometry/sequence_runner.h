@@ -12,7 +12,13 @@
 //                        coverage (Sim(3)-aligned), scale_drift and window_scales (1 s windows);
 //   OUT/trajectory.svg   top view of the Sim(3)-aligned estimate over the ground truth;
 //   OUT/trajectory_compare.txt  with odometry.compare_solver: the other solver's poses on the
-//                        same tracking problems (summary.json `compare_solver`).
+//                        same tracking problems (summary.json `compare_solver`);
+//   OUT/keyframes_ba.txt with backend.windowed_ba: every keyframe's pose after the last BA window
+//                        that held it, TUM format, written at the end (summary.json
+//                        `windowed_ba`). trajectory.txt keeps each frame as it was output: tracked
+//                        against its keyframe as refined by the windows applied up to then;
+//   OUT/trajectory_ba.txt with backend.windowed_ba: every tracked frame re-anchored to its
+//                        keyframe's final pose (world_from_kf_final * kf_from_cam), at the end.
 // A frame that fails to load is reported with its file, marked failed and skipped.
 #ifndef PLDVO_BACKEND_ODOMETRY_SEQUENCE_RUNNER_H_
 #define PLDVO_BACKEND_ODOMETRY_SEQUENCE_RUNNER_H_

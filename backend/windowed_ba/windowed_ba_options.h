@@ -1,7 +1,8 @@
 // Options of windowed photometric + line bundle adjustment (docs/windowed_ba.md). One typed
 // struct: read from YAML and `--set` through VisitFields (core/config_io.h, unknown keys are
-// errors), validated by Check(). Not yet a section of the odometry's config: the BA does not run
-// in the odometry loop yet (docs/windowed_ba.md, "Not done yet").
+// errors), validated by Check(). The odometry's config holds it as `backend.windowed_ba`
+// (backend/odometry/odometry_config.h); the odometry runs it when `enabled` (docs/windowed_ba.md,
+// "In the odometry").
 #ifndef PLDVO_BACKEND_WINDOWED_BA_WINDOWED_BA_OPTIONS_H_
 #define PLDVO_BACKEND_WINDOWED_BA_WINDOWED_BA_OPTIONS_H_
 
@@ -36,6 +37,8 @@ inline const ChoiceNames<WindowedBASolver>& WindowedBASolverNames() {
 using WindowedBALinearSolver = BALinearSolver;
 
 struct WindowedBAOptions {
+  // Off by default: the odometry runs without the windowed BA unless asked.
+  bool enabled = false;
   // The registered problem builder (WindowedBAProblemBuilderRegistry): "windowed_ba" (robust
   // loss row-wise inside the cost functions) or "windowed_ba_ceres_loss" (the loss given to the
   // problem per residual block, i.e. per point pattern and target).
@@ -85,9 +88,22 @@ struct WindowedBAOptions {
   int max_iterations = 20;
   double function_tolerance = 1e-6;
   int num_threads = 1;
+  // Windows waiting in WindowedBundleAdjuster's queue (odometry with the mapping thread); a new
+  // one beyond this drops the oldest pending one (a newer window supersedes it).
+  int max_queue = 2;
+  // Odometry: the current keyframe's depth-filter hypotheses are shifted by the optimised
+  // points' corrections (DepthMapper::ApplyIdepthCorrections); false: poses only.
+  bool depth_feedback = true;
+  // ... and with depth_feedback, the current keyframe's other hypotheses re-expressed in its frame
+  // as the BA moved it relative to the keyframe its map was propagated from (off: only the
+  // optimised points change; docs/windowed_ba.md compares the two).
+  bool warp_current_map = false;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
+    v.Field("enabled", &enabled,
+            "Run windowed photometric + line bundle adjustment over the newest keyframes "
+            "beside tracking (default false).");
     v.Field("problem_builder", &problem_builder,
             "Registered windowed BA problem builder: windowed_ba (row-wise loss) or "
             "windowed_ba_ceres_loss (loss per residual block).");
@@ -118,6 +134,14 @@ struct WindowedBAOptions {
     v.Field("max_iterations", &max_iterations, "Iterations per window.");
     v.Field("function_tolerance", &function_tolerance, "Relative cost-change tolerance.");
     v.Field("num_threads", &num_threads, "Ceres threads per solve.");
+    v.Field("max_queue", &max_queue,
+            "Pending windows in the worker's queue (oldest dropped; default 2).");
+    v.Field("depth_feedback", &depth_feedback,
+            "Shift the current keyframe's depth-filter hypotheses by the optimised points' "
+            "corrections (default true); false: poses only.");
+    v.Field("warp_current_map", &warp_current_map,
+            "depth_feedback: also re-express the current keyframe's other hypotheses in its "
+            "frame as moved by the BA relative to its propagation source (default false).");
   }
   // "" when valid, otherwise what is wrong (names the key; an unknown problem_builder lists the
   // registered ones).

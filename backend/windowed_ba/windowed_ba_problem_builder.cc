@@ -266,6 +266,7 @@ std::string WindowedBAOptions::Check() const {
   if (max_iterations < 0) return "max_iterations must be >= 0";
   if (!(function_tolerance >= 0.0)) return "function_tolerance must be >= 0";
   if (num_threads < 1) return "num_threads must be >= 1";
+  if (max_queue < 1) return "max_queue must be >= 1";
   const std::string weighting_error = weighting.Check();
   if (!weighting_error.empty()) return "weighting: " + weighting_error;
   return "";

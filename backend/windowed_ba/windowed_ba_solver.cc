@@ -26,13 +26,18 @@ ceres::Solver::Options MakeWindowedBACeresOptions(const WindowedBAOptions& optio
   ceres::Solver::Options solver_options =
       MakeBundleAdjustmentCeresOptions(options.linear_solver, options.max_iterations,
                                        options.function_tolerance, options.num_threads);
-  // Inverse depths (group 0) eliminated first; every other block, constant ones included, in
-  // group 1.
+  // Inverse depths (group 0) eliminated first; every other block, constant ones included, after
+  // them in a group of its own, in the order they were added. Ceres orders the elements of a
+  // group by address, and the poses and brightness live in separate arrays whose relative
+  // addresses differ between runs: one group for all of them made the reduced camera system's
+  // column order, and with it the solution's rounding, differ from run to run.
   const std::vector<double*> eliminated = problem.problem.EliminatedBlocks();
   if (!eliminated.empty()) {
     auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+    int next_group = 1;
     for (const LeastSquaresProblem::ParameterBlock& block : problem.problem.parameter_blocks()) {
-      ordering->AddElementToGroup(block.values, block.eliminated && !block.constant ? 0 : 1);
+      ordering->AddElementToGroup(block.values,
+                                  block.eliminated && !block.constant ? 0 : next_group++);
     }
     solver_options.linear_solver_ordering = ordering;
   }

@@ -41,6 +41,7 @@ struct WindowedBAResultPoint {
   double idepth = 0.0;   // refined
 };
 struct WindowedBAResult {
+  long sequence = -1;  // WindowedBundleAdjuster::Submit's number (-1: solved directly)
   SolverSummary summary;
   std::vector<WindowedBAResultKeyframe> keyframes;  // the window's keyframes, oldest first
   std::vector<WindowedBAResultPoint> points;        // the points that entered the problem

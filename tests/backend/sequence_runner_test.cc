@@ -1,6 +1,7 @@
 // Tests of SequenceRunner (backend/odometry/sequence_runner.h), in-process: the run loop writes
 // every output, the ground truth it writes gives evo the same comparison as the run's own
-// evaluation, and an output that cannot be written stops the run with RunOutputError.
+// evaluation, the windowed BA's outputs, and an output that cannot be written stops the run with
+// RunOutputError.
 #include "backend/odometry/sequence_runner.h"
 
 #include <gtest/gtest.h>
@@ -76,6 +77,44 @@ TEST(SequenceRunnerTest, WritesEveryOutputAndAGroundTruthEvoCanCompare) {
   // The report: counts, the component table, the evaluation, the output folder.
   ASSERT_GE(result.report.size(), 3u);
   EXPECT_NE(result.report[0].find("36 frames, 36 tracked"), std::string::npos) << result.report[0];
+}
+
+// backend.windowed_ba: keyframes_ba.txt has a pose per keyframe, trajectory_ba.txt every tracked
+// frame re-anchored to its keyframe's final pose (a keyframe frame takes that pose exactly), and
+// summary.json `windowed_ba` counts the windows.
+TEST(SequenceRunnerTest, WindowedBAWritesKeyframeAndReanchoredTrajectories) {
+  const std::unique_ptr<Dataset> dataset = OpenDataset(SequenceDir().string());
+  SequenceRunOptions options;
+  options.out_dir = (test::TestRoot() / "runner_windowed_ba").string();
+  options.dataset_label = SequenceDir().string();
+  options.max_frames = 24;  // 4 keyframes, 3 windows
+  OdometryConfig config = DeterministicConfig();
+  config.keyframes.max_frames = 6;
+  config.backend.windowed_ba.enabled = true;
+  config.backend.windowed_ba.max_points = 500;
+  SequenceRunner runner(*dataset, config, options);
+  const SequenceRunResult result = runner.Run();
+  ASSERT_TRUE(result.summary.contains("windowed_ba"));
+  const nlohmann::json& ba = result.summary["windowed_ba"];
+  const int keyframes = result.summary["keyframes"].get<int>();
+  EXPECT_GE(ba["windows"].get<int>(), 2);
+  EXPECT_EQ(ba["applied"], ba["windows"]);
+  const Trajectory keyframes_ba = ReadTrajectoryTum(options.out_dir + "/keyframes_ba.txt");
+  EXPECT_EQ(static_cast<int>(keyframes_ba.size()), keyframes);
+  const Trajectory estimate = ReadTrajectoryTum(options.out_dir + "/trajectory.txt");
+  const Trajectory reanchored = ReadTrajectoryTum(options.out_dir + "/trajectory_ba.txt");
+  ASSERT_EQ(reanchored.size(), estimate.size());
+  int keyframe_frames = 0;
+  for (const StampedPose& keyframe : keyframes_ba) {
+    for (const StampedPose& pose : reanchored) {
+      if (pose.timestamp != keyframe.timestamp) continue;
+      ++keyframe_frames;
+      // The TUM files' shortest exact decimals: equal to rounding of the quaternion round trip.
+      EXPECT_LT((pose.world_from_cam.translation() - keyframe.world_from_cam.translation()).norm(),
+                1e-12);
+    }
+  }
+  EXPECT_EQ(keyframe_frames, keyframes);
 }
 
 TEST(SequenceRunnerTest, AnOutputFolderThatCannotBeMadeIsAnOutputError) {

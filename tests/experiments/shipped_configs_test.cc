@@ -79,6 +79,7 @@ const std::map<std::string, std::function<void(const OdometryConfig&)>>& Cases()
          ExpectLinesInMappingAndTracking(c, "points_lines");
          ExpectExtras(c, true, "points_lines");
          EXPECT_FALSE(c.backend.edge_ba.enabled);
+         EXPECT_FALSE(c.backend.windowed_ba.enabled);
        }},
       {"points_lines_edge_ba",
        [](const OdometryConfig& c) {
@@ -89,6 +90,18 @@ const std::map<std::string, std::function<void(const OdometryConfig&)>>& Cases()
          EXPECT_EQ(c.backend.edge_ba.window, 5);
          EXPECT_EQ(c.backend.edge_ba.max_iterations, 20);
          EXPECT_EQ(c.backend.edge_ba.lines_leaving_window, EdgeBALeavingLines::kFree);
+       }},
+      {"points_lines_ba",
+       [](const OdometryConfig& c) {
+         EXPECT_EQ(c.tracking.problem.weighting.policy, Policy::kCovariance);
+         ExpectLinesInMappingAndTracking(c, "points_lines_ba");
+         ExpectExtras(c, true, "points_lines_ba");
+         EXPECT_FALSE(c.backend.edge_ba.enabled);
+         EXPECT_TRUE(c.backend.windowed_ba.enabled);
+         EXPECT_EQ(c.backend.windowed_ba.window, 5);
+         EXPECT_EQ(c.backend.windowed_ba.max_points, 2000);
+         EXPECT_EQ(c.backend.windowed_ba.max_iterations, 20);
+         EXPECT_TRUE(c.backend.windowed_ba.lines);
        }},
       {"sdvo",
        [](const OdometryConfig& c) {
