@@ -13,32 +13,22 @@
 #ifndef PLDVO_BACKEND_EDGE_BA_EDGE_BA_ADJUSTER_H_
 #define PLDVO_BACKEND_EDGE_BA_EDGE_BA_ADJUSTER_H_
 
-#include <condition_variable>
-#include <deque>
 #include <functional>
-#include <mutex>
 #include <optional>
-#include <thread>
 
 #include "backend/edge_ba/edge_ba_options.h"
 #include "backend/edge_ba/edge_ba_window.h"
+#include "backend/optimization/background_solver.h"
 
 namespace pldvo {
 
 class EdgeBundleAdjuster {
  public:
   using ResultCallback = std::function<void(const EdgeBAResult&)>;
-  struct Statistics {
-    long submitted = 0;
-    long solved = 0;           // results produced (successful or not)
-    long dropped_windows = 0;  // superseded in the queue before being solved
-    long dropped_results = 0;  // not polled in time
-  };
+  using Statistics = BackgroundSolver<EdgeBAWindow, EdgeBAResult>::Statistics;
 
   // Starts the worker. Throws std::invalid_argument on invalid options.
   explicit EdgeBundleAdjuster(const EdgeBAOptions& options, ResultCallback callback = nullptr);
-  // Finishes the window being solved, discards pending ones, joins the worker.
-  ~EdgeBundleAdjuster();
   EdgeBundleAdjuster(const EdgeBundleAdjuster&) = delete;
   EdgeBundleAdjuster& operator=(const EdgeBundleAdjuster&) = delete;
 
@@ -46,26 +36,16 @@ class EdgeBundleAdjuster {
   // queues it and returns its sequence number (EdgeBAResult::sequence).
   long Submit(EdgeBAWindow window);
   // The oldest unpolled result, or nothing.
-  std::optional<EdgeBAResult> Poll();
+  std::optional<EdgeBAResult> Poll() { return solver_.Poll(); }
   // Blocks until every queued window has been solved (tests, benchmarks, end of a sequence).
-  void WaitIdle();
-  Statistics statistics() const;
+  void WaitIdle() { solver_.WaitIdle(); }
+  Statistics statistics() const { return solver_.statistics(); }
 
  private:
-  void Run();
-
   const EdgeBAOptions options_;
-  const ResultCallback callback_;
-  mutable std::mutex mutex_;
-  std::condition_variable work_available_;
-  std::condition_variable idle_;
-  std::deque<std::pair<long, EdgeBAWindow>> pending_;
-  std::deque<EdgeBAResult> results_;
-  bool busy_ = false;
-  bool stop_ = false;
-  long next_sequence_ = 0;
-  Statistics statistics_;
-  std::thread worker_;  // last: starts after every member above is constructed
+  // Last: its worker reads options_; destroying it first finishes the window being solved,
+  // discards pending ones and joins the worker.
+  BackgroundSolver<EdgeBAWindow, EdgeBAResult> solver_;
 };
 
 }  // namespace pldvo

@@ -316,13 +316,9 @@ void Odometry::ApplyWindowedBA(const WindowedBAResult& result) {
   std::vector<IdepthCorrection> corrections;
   if (!windowed_ba_keyframes_->Apply(result, keyframe_.id, &corrections)) return;
   ++stats_.windowed_ba_applied;
-  // The current keyframe's refined pose; the last good frame was tracked against it (or is it),
-  // so it moves rigidly with it (re-anchored) and the motion model (relative) stays valid.
   SE3 world_from_kf;
   if (windowed_ba_keyframes_->WorldFromKeyframe(keyframe_.id, &world_from_kf)) {
-    world_from_last_good_ =
-        world_from_kf * keyframe_.world_from_kf.Inverse() * world_from_last_good_;
-    keyframe_.world_from_kf = world_from_kf;
+    MoveCurrentKeyframe(world_from_kf);
   }
   if (retiring_.id >= 0) {
     windowed_ba_keyframes_->WorldFromKeyframe(retiring_.id, &retiring_.world_from_kf);
@@ -381,6 +377,11 @@ void Odometry::PollEdgeBA() {
   while (std::optional<EdgeBAResult> result = edge_ba_adjuster_->Poll()) ApplyEdgeBA(*result);
 }
 
+void Odometry::MoveCurrentKeyframe(const SE3& world_from_kf) {
+  world_from_last_good_ = world_from_kf * keyframe_.world_from_kf.Inverse() * world_from_last_good_;
+  keyframe_.world_from_kf = world_from_kf;
+}
+
 void Odometry::ApplyEdgeBA(const EdgeBAResult& result) {
   ++stats_.edge_ba_windows;
   edge_ba_times_ms_.push_back(1e3 * (result.build_seconds + result.solve_seconds));
@@ -389,13 +390,9 @@ void Odometry::ApplyEdgeBA(const EdgeBAResult& result) {
   }
   if (!edge_ba_window_->Apply(result)) return;
   ++stats_.edge_ba_applied;
-  // The current keyframe's refined pose; the last good frame was tracked against it (or is it),
-  // so it moves rigidly with it and the motion model (a relative motion) stays valid.
   SE3 world_from_kf;
   if (edge_ba_window_->WorldFromKeyframe(keyframe_.id, &world_from_kf)) {
-    world_from_last_good_ =
-        world_from_kf * keyframe_.world_from_kf.Inverse() * world_from_last_good_;
-    keyframe_.world_from_kf = world_from_kf;
+    MoveCurrentKeyframe(world_from_kf);
   }
   if (retiring_.id >= 0) edge_ba_window_->WorldFromKeyframe(retiring_.id, &retiring_.world_from_kf);
   if (config_.backend.edge_ba.line_depth_feedback) SendLineDepths(result);

@@ -215,6 +215,9 @@ class Odometry {
   void UpdateWindowedBA(const KeyframeMap& map);
   void PollWindowedBA();
   void ApplyWindowedBA(const WindowedBAResult& result);
+  // A bundle adjustment moved the current keyframe to world_from_kf: the last good frame, tracked
+  // against it (or it), moves rigidly with it, so the motion model (relative) stays valid.
+  void MoveCurrentKeyframe(const SE3& world_from_kf);
   void NotifyRetired(const KeyframeMap& map);
   // A new keyframe's first published map: a fresh random map on a re-initialisation keyframe
   // loses the scale (scale_lost_).

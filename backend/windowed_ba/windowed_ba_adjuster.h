@@ -14,13 +14,9 @@
 #ifndef PLDVO_BACKEND_WINDOWED_BA_WINDOWED_BA_ADJUSTER_H_
 #define PLDVO_BACKEND_WINDOWED_BA_WINDOWED_BA_ADJUSTER_H_
 
-#include <condition_variable>
-#include <deque>
-#include <mutex>
 #include <optional>
-#include <thread>
-#include <utility>
 
+#include "backend/optimization/background_solver.h"
 #include "backend/windowed_ba/windowed_ba_options.h"
 #include "backend/windowed_ba/windowed_ba_solver.h"
 #include "backend/windowed_ba/windowed_ba_window.h"
@@ -29,17 +25,10 @@ namespace pldvo {
 
 class WindowedBundleAdjuster {
  public:
-  struct Statistics {
-    long submitted = 0;
-    long solved = 0;           // results produced (successful or not)
-    long dropped_windows = 0;  // superseded in the queue before being solved
-    long dropped_results = 0;  // not polled in time
-  };
+  using Statistics = BackgroundSolver<WindowedBAWindow, WindowedBAResult>::Statistics;
 
   // Starts the worker. Throws std::invalid_argument on invalid options.
   explicit WindowedBundleAdjuster(const WindowedBAOptions& options);
-  // Finishes the window being solved, discards pending ones, joins the worker.
-  ~WindowedBundleAdjuster();
   WindowedBundleAdjuster(const WindowedBundleAdjuster&) = delete;
   WindowedBundleAdjuster& operator=(const WindowedBundleAdjuster&) = delete;
 
@@ -47,25 +36,16 @@ class WindowedBundleAdjuster {
   // thread), queues it and returns its sequence number (WindowedBAResult::sequence).
   long Submit(WindowedBAWindow window);
   // The oldest unpolled result, or nothing.
-  std::optional<WindowedBAResult> Poll();
+  std::optional<WindowedBAResult> Poll() { return solver_.Poll(); }
   // Blocks until every queued window has been solved (tests, end of a sequence).
-  void WaitIdle();
-  Statistics statistics() const;
+  void WaitIdle() { solver_.WaitIdle(); }
+  Statistics statistics() const { return solver_.statistics(); }
 
  private:
-  void Run();
-
   const WindowedBAOptions options_;
-  mutable std::mutex mutex_;
-  std::condition_variable work_available_;
-  std::condition_variable idle_;
-  std::deque<std::pair<long, WindowedBAWindow>> pending_;
-  std::deque<WindowedBAResult> results_;
-  bool busy_ = false;
-  bool stop_ = false;
-  long next_sequence_ = 0;
-  Statistics statistics_;
-  std::thread worker_;  // last: starts after every member above is constructed
+  // Last: its worker reads options_; destroying it first finishes the window being solved,
+  // discards pending ones and joins the worker.
+  BackgroundSolver<WindowedBAWindow, WindowedBAResult> solver_;
 };
 
 }  // namespace pldvo
