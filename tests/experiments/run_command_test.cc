@@ -325,8 +325,9 @@ TEST(RunCommandTest, BootstrapRefinementRerunsTheFirstKeyframeFrames) {
 
 // odometry.two_view_bootstrap: the run reports the second view and tracks every frame from frame
 // 0's bootstrapped map (gates lowered to 0.3 deg and 1 px: this sequence moves forward and reaches
-// neither default in 36 frames; TwoViewBootstrapTest checks the geometry); when the bootstrap fails (two frames, no parallax) the run starts
-// from the random map and says why; combinations with the other starts are config errors.
+// neither default in 36 frames; TwoViewBootstrapTest checks the geometry); when the bootstrap
+// fails (two frames, no parallax) the run starts from the random map and says why; combinations
+// with the other starts are config errors.
 TEST(RunCommandTest, TwoViewBootstrapStartsTheRunOrFallsBack) {
   const std::string kFlags = kDeterministic + std::string(" --max_frames 36");
   const fs::path run = TestRoot() / "run_two_view";
