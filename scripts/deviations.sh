@@ -79,6 +79,7 @@ prior_line_gate	odometry.line_prior_gate_px=2	odometry.line_prior_gate_px=0	Unma
 post_line_gate	odometry.line_outlier_px=2	odometry.line_outlier_px=0	The same check after tracking; lines that fail are unmatched and the frame is tracked again.
 predicted_matching	odometry.predict_line_matches=true	odometry.predict_line_matches=false	Matches lines near their homography-predicted position (tighter radius and angle gates).
 two_view_bootstrap	odometry.two_view_bootstrap=true	odometry.two_view_bootstrap=false	Starts from frame 0's map of a two-view geometry of tracked corners instead of the random map; where it fails the run starts as without it (docs/bootstrap.md).
+consensus_check	odometry.line_consensus_max_cost_drop=8.4	odometry.line_consensus_max_cost_drop=0	Drops a frame's line term when a photometric-only solve from its result lowers the photometric cost by more than chi^2_6(0.99)/2: wrong line matches (repetitive patterns, occlusion edges) cannot drag the pose (docs/tracking.md).
 alternative_poses	odometry.try_alternatives=true	odometry.try_alternatives=false	Retries lost or high-residual frames from zero motion and small rotations.
 point_budget_4000	mapping.max_reference_points=4000	mapping.max_reference_points=0	At most 4000 tracking reference points per pyramid level: bounds the tracking time.
 no_line_regularisation	mapping.line_regularization=false	mapping.line_regularization=true	Leaves out the paper's 3D line regularisation (eqs. 11-13), which made points_lines worse on most of the development set (docs/mapping.md).

@@ -543,7 +543,10 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, PreparedFrame
   UpdateReference(association.lines_in_cur, &timing);
   TrackingResult tracking =
       TrackFrame(frame.pyramid, frame.image, index, prior_cur_from_kf, &association, &result);
-  if (compare_tracker_ != nullptr && tracking.status != TrackingStatus::kLost) {
+  // A frame whose line term the consensus check dropped keeps a photometric-only solve, not the
+  // tracking problem the other solver would solve: it is not compared.
+  if (compare_tracker_ != nullptr && tracking.status != TrackingStatus::kLost &&
+      !result.line_term_dropped) {
     CompareSolvers(frame.pyramid, tracking, &result);
   }
   if (tracking.status == TrackingStatus::kLost) {

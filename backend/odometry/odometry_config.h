@@ -87,8 +87,8 @@ struct OdometryOptions {
   // pulled the pose against the photometric evidence, and the frame keeps the photometric pose
   // (OdometryFrameResult::line_term_dropped). A pose the photometric term leaves free (a
   // texture-less direction) costs it nothing, so lines keep constraining it there.
-  // chi^2_6 at 99% is 16.8, i.e. 8.4 in cost; 0 = off.
-  double line_consensus_max_cost_drop = 0.0;
+  // chi^2_6 at 99% is 16.8, i.e. 8.4 in cost; 0 = off (the paper).
+  double line_consensus_max_cost_drop = 8.4;
   // Alternative initial guesses (besides the constant-velocity prior) are tried when the result
   // is lost, or when its final photometric RMS exceeds retry_rms_ratio times the running mean
   // over recent tracked frames (backend/odometry/retry_trigger.h): zero motion since the last good
@@ -155,7 +155,9 @@ struct OdometryOptions {
   // Solver comparison (docs/tracking.md): every tracked frame's final tracking problem (the same
   // reference, lines and initial pose) is solved a second time with this solver; its poses, RPE
   // and time are reported beside the run's (summary.json `compare_solver`,
-  // trajectory_compare.txt) and do not influence the run. Not counted in tracking_thread.
+  // trajectory_compare.txt) and do not influence the run. Not counted in tracking_thread. Frames
+  // whose line term the consensus check dropped are not compared (their pose is not that
+  // problem's).
   enum class CompareSolver { kNone, kCeres, kGaussNewton };
   CompareSolver compare_solver = CompareSolver::kNone;
 

@@ -220,6 +220,8 @@ TEST(OdometryTest, CompareSolverSolvesTheSameProblemsWithoutChangingTheRun) {
   // The run without the comparison, on the repeatability prefix: a deterministic run's first
   // frames do not depend on how many follow.
   OdometryConfig config = DeterministicConfig();
+  // Every frame compared: no frame keeps the consensus check's photometric pose instead.
+  config.odometry.line_consensus_max_cost_drop = 0.0;
   const RunResult plain = RunSequence(config, {}, kRepeatFrames);
   config.odometry.compare_solver = OdometryOptions::CompareSolver::kCeres;
   const RunResult run = RunSequence(config);
@@ -263,6 +265,20 @@ TEST(OdometryTest, CompareSolverSolvesTheSameProblemsWithoutChangingTheRun) {
   const double rpe_run = EvaluateTrajectory(gt, run.estimate).rpe_cm_s;
   const double rpe_compared = EvaluateTrajectory(gt, compared).rpe_cm_s;
   EXPECT_NEAR(rpe_compared, rpe_run, 0.01 * rpe_run);
+}
+
+TEST(OdometryTest, FramesWhoseLineTermWasDroppedAreNotCompared) {
+  OdometryConfig config = DeterministicConfig();
+  config.odometry.compare_solver = OdometryOptions::CompareSolver::kGaussNewton;
+  ASSERT_GT(config.odometry.line_consensus_max_cost_drop, 0.0);  // the default
+  const RunResult run = RunSequence(config, {}, kRepeatFrames);
+  int dropped = 0;
+  for (const OdometryFrameResult& frame : run.frames) {
+    if (!IsTracked(frame.status) || frame.index == 0) continue;
+    dropped += frame.line_term_dropped;
+    EXPECT_EQ(frame.compared, !frame.line_term_dropped) << "frame " << frame.index;
+  }
+  EXPECT_GT(dropped, 0);
 }
 
 TEST(OdometryTest, BlankFrameIsLostAndTrackingRecovers) {

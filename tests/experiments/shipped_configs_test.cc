@@ -62,6 +62,7 @@ void ExpectExtras(const OdometryConfig& config, bool on, const std::string& name
   EXPECT_EQ(config.odometry.line_outlier_px, on ? 2.0 : 0.0);
   EXPECT_EQ(config.odometry.try_alternatives, on);
   EXPECT_EQ(config.odometry.two_view_bootstrap, on);
+  EXPECT_EQ(config.odometry.line_consensus_max_cost_drop, on ? 8.4 : 0.0);
 }
 
 // Per shipped file: what its header comment says it turns on.
