@@ -694,8 +694,9 @@ void Odometry::MapOrSwitchKeyframe(int index, double timestamp, const cv::Mat& i
   const int overlap_level = std::min(2, reference_.num_levels() - 1);
   const double overlap = ReferenceOverlap(reference_, overlap_level, cur_from_kf);
   timing.reference_ms += MsSince(start);
-  const KeyframeDecision decision = DecideKeyframe(
-      config_.keyframes, cur_from_kf, map_->mean_idepth, overlap, keyframe_.frames_tracked);
+  const KeyframeDecision decision =
+      DecideKeyframe(config_.keyframes, cur_from_kf, map_->mean_idepth, overlap,
+                     tracking.inlier_fraction, keyframe_.frames_tracked);
   if (decision.new_keyframe) {
     // The new keyframe's segments that the verified matches tie to the old keyframe's.
     std::vector<int> previous_segment(lines.segments.size(), -1);

@@ -9,6 +9,9 @@ std::string KeyframeOptions::Check() const {
   if (!(min_overlap >= 0.0 && min_overlap <= 1.0)) return "min_overlap must be in [0, 1]";
   if (min_frames < 1) return "min_frames must be >= 1";
   if (max_frames < 0) return "max_frames must be >= 0";
+  if (!(min_inlier_fraction >= 0.0 && min_inlier_fraction <= 1.0)) {
+    return "min_inlier_fraction must be in [0, 1]";
+  }
   return "";
 }
 

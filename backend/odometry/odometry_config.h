@@ -46,6 +46,10 @@ struct KeyframeOptions {
   int min_frames = 3;
   // Always a new keyframe after this many tracked frames (0 = no limit).
   int max_frames = 0;
+  // New keyframe when fewer than this fraction of the tracked frame's valid rows are inliers
+  // (TrackingResult::inlier_fraction): the keyframe no longer looks like the scene (exposure
+  // drift, blur) though the frame is still tracked (tracking.min_inlier_fraction); 0 = off.
+  double min_inlier_fraction = 0.5;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
@@ -58,6 +62,9 @@ struct KeyframeOptions {
             "Frames tracked against a keyframe before another may be created (default 3).");
     v.Field("max_frames", &max_frames,
             "New keyframe after this many tracked frames; 0 = no limit (default 0).");
+    v.Field("min_inlier_fraction", &min_inlier_fraction,
+            "New keyframe when fewer of the tracked frame's valid rows are inliers; 0 = off "
+            "(default 0.5).");
   }
   std::string Check() const;
 };

@@ -53,8 +53,8 @@ struct TrackingOptions {
   int min_valid_residuals = 30;
   double min_valid_fraction = 0.3;
   double inlier_threshold = 2.0;  // whitened units: 2 sigma of the residual model
-  double min_inlier_fraction = 0.5;
-  double min_intensity_correlation = 0.3;
+  double min_inlier_fraction = 0.3;
+  double min_intensity_correlation = 0.4;
   // Compute the reprojected edge pixels for the iteration callback (the paper's Fig. 2).
   bool record_edge_pixels = true;
   // Compute the pose covariance (J^T J)^-1 of the finest level at the solution
@@ -79,7 +79,7 @@ struct TrackingOptions {
             "Lost when fewer than this fraction of the valid rows are inliers.");
     v.Field("min_intensity_correlation", &min_intensity_correlation,
             "Lost when the correlation of I_ref and I_cur over the valid photometric rows is "
-            "below this (0.3; -1: off).");
+            "below this (0.4; -1: off).");
     v.Field("record_edge_pixels", &record_edge_pixels,
             "Give the iteration callback the reprojected edge pixels (Fig. 2).");
     v.Field("pose_covariance", &pose_covariance,
