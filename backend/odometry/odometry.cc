@@ -640,8 +640,10 @@ TrackingResult Odometry::TrackFrame(const ImagePyramid& pyramid, const cv::Mat& 
   }
   if (consensus_ != nullptr && result->num_matches > 0 &&
       tracking.status != TrackingStatus::kLost) {
-    if (std::optional<TrackingResult> photometric =
-            consensus_->Check(reference_, pyramid, tracking)) {
+    const auto consensus_start = WallClock::now();
+    std::optional<TrackingResult> photometric = consensus_->Check(reference_, pyramid, tracking);
+    result->timing.consensus_ms = MsSince(consensus_start);
+    if (photometric) {
       tracking = std::move(*photometric);
       result->line_term_dropped = true;
     }

@@ -40,6 +40,7 @@ struct OdometryTiming {
   double wait_ms = 0.0;         // waiting for a new keyframe's map (parallel mapping)
   double reference_ms = 0.0;    // matched lines into the tracking reference, overlap
   double tracking_ms = 0.0;     // coarse-to-fine tracking incl. alternative guesses
+  double consensus_ms = 0.0;    // of tracking_ms: the photometric consensus check's solve
   // Parallel mapping: mapping work finished on the mapping thread since the previous frame;
   // inline mapping: this frame's mapping job.
   double mapping_ms = 0.0;

@@ -39,16 +39,16 @@ namespace {
 
 // The per-frame timing columns, in timing.csv order; the summary's ms objects use the same keys.
 const char* const kTimingKeys[] = {
-    "load", "pyramid",   "detection", "description", "matching",        "tracing",
-    "wait", "reference", "tracking",  "mapping",     "tracking_thread", "total"};
+    "load",      "pyramid",  "detection", "description", "matching",        "tracing", "wait",
+    "reference", "tracking", "consensus", "mapping",     "tracking_thread", "total"};
 constexpr size_t kNumTimingKeys = std::size(kTimingKeys);
 using TimingRow = std::array<double, kNumTimingKeys>;
 
 TimingRow MakeTimingRow(const OdometryTiming& t, double load_ms, double total_ms) {
-  return {load_ms,          t.pyramid_ms,         t.detection_ms,
-          t.description_ms, t.matching_ms,        t.tracing_ms,
-          t.wait_ms,        t.reference_ms,       t.tracking_ms,
-          t.mapping_ms,     t.tracking_thread_ms, total_ms};
+  return {load_ms,       t.pyramid_ms,   t.detection_ms, t.description_ms,
+          t.matching_ms, t.tracing_ms,   t.wait_ms,      t.reference_ms,
+          t.tracking_ms, t.consensus_ms, t.mapping_ms,   t.tracking_thread_ms,
+          total_ms};
 }
 
 nlohmann::json NumberOrNull(double value) {
