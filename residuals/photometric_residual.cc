@@ -172,6 +172,21 @@ inline bool PhotometricRow(const Sampler& sample, const PinholeCamera& camera,
 
 bool PhotometricResidual::Evaluate(double const* const* parameters, double* residuals,
                                    double** jacobians) const {
+  const bool with_brightness = brightness_ == BrightnessModel::kAffine;
+  EvaluateRows(parameters, residuals, jacobians != nullptr ? jacobians[0] : nullptr, nullptr,
+               jacobians != nullptr && with_brightness ? jacobians[1] : nullptr);
+  return true;
+}
+
+bool PhotometricResidual::EvaluatePoseTangent(double const* const* parameters, double* residuals,
+                                              double* jacobian_tangent) const {
+  EvaluateRows(parameters, residuals, nullptr, jacobian_tangent, nullptr);
+  return true;
+}
+
+void PhotometricResidual::EvaluateRows(double const* const* parameters, double* residuals,
+                                       double* jacobian_ambient, double* jacobian_tangent,
+                                       double* jacobian_brightness) const {
   const SE3 cur_from_ref = PoseFromParameters(parameters[0]);
   const Eigen::Matrix3d rotation = cur_from_ref.rotation_matrix();
   const Eigen::Vector3d& translation = cur_from_ref.translation();
@@ -179,25 +194,25 @@ bool PhotometricResidual::Evaluate(double const* const* parameters, double* resi
   const double root_gain = with_brightness ? std::exp(0.5 * parameters[1][0]) : 1.0;
   const double inverse_root_gain = 1.0 / root_gain;
   const double bias = with_brightness ? parameters[1][1] : 0.0;
-  double* jacobian = (jacobians != nullptr) ? jacobians[0] : nullptr;
-  double* jacobian_brightness = (jacobians != nullptr && with_brightness) ? jacobians[1] : nullptr;
   const MinusJacobianMatrix minus_jacobian =
-      jacobian != nullptr ? PoseMinusJacobian(parameters[0]) : MinusJacobianMatrix::Zero();
+      jacobian_ambient != nullptr ? PoseMinusJacobian(parameters[0]) : MinusJacobianMatrix::Zero();
   const int n = num_observations();
   WithSampler(interpolation_, cur_pyramid_, level_, bicubic_.get(), [&](const auto& sample) {
     double row_tangent[kPoseTangentSize];
     for (int i = 0; i < n; ++i) {
+      double* tangent = jacobian_tangent != nullptr   ? jacobian_tangent + i * kPoseTangentSize
+                        : jacobian_ambient != nullptr ? row_tangent
+                                                      : nullptr;
       valid_[i] = PhotometricRow(
           sample, camera_, observations_[i], rays_in_ref_[i], rotation, translation, root_gain,
-          inverse_root_gain, bias, loss_, residuals + i,
-          jacobian != nullptr ? row_tangent : nullptr,
+          inverse_root_gain, bias, loss_, residuals + i, tangent,
           jacobian_brightness != nullptr ? jacobian_brightness + i * kBrightnessSize : nullptr);
-      if (jacobian != nullptr) {
-        LiftTangentJacobian(minus_jacobian, row_tangent, 1, jacobian + i * kPoseAmbientSize);
+      if (jacobian_ambient != nullptr) {
+        LiftTangentJacobian(minus_jacobian, row_tangent, 1,
+                            jacobian_ambient + i * kPoseAmbientSize);
       }
     }
   });
-  return true;
 }
 
 void PhotometricResidual::EvaluateTangent(const SE3& cur_from_ref, double* residuals,

@@ -73,6 +73,7 @@
 #include "core/pinhole_camera.h"
 #include "core/se3.h"
 #include "residuals/affine_brightness.h"
+#include "residuals/pose_tangent_cost_function.h"
 
 namespace pldvo {
 
@@ -93,7 +94,7 @@ struct PhotometricObservation {
   double sqrt_info = 1.0;                                  // 1 / sqrt(Sigma_r), >= 0
 };
 
-class PhotometricResidual : public ceres::CostFunction {
+class PhotometricResidual : public ceres::CostFunction, public PoseTangentCostFunction {
  public:
   // `camera` is the camera of `level` (PinholeCamera::AtLevel). Throws std::invalid_argument on
   // an empty batch, a level outside the pyramid, a camera whose size differs from the level's,
@@ -117,6 +118,9 @@ class PhotometricResidual : public ceres::CostFunction {
   // requested, is N x 7 row-major, jacobians[1] N x 2.
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
+  // The rows of Evaluate() with the pose Jacobian in the tangent space (N x 6 row-major).
+  bool EvaluatePoseTangent(double const* const* parameters, double* residuals,
+                           double* jacobian_tangent) const override;
 
   // The same rows for a pose given as SE3 and a = b = 0, with the Jacobian in the tangent space
   // (N x 6 row-major, may be nullptr) and validity written to `valid` (N entries, may be
@@ -142,6 +146,11 @@ class PhotometricResidual : public ceres::CostFunction {
   int num_valid() const;
 
  private:
+  // Evaluate() with the pose Jacobian lifted to the 7 parameters (jacobian_ambient) or in the
+  // tangent (jacobian_tangent); each may be nullptr.
+  void EvaluateRows(double const* const* parameters, double* residuals, double* jacobian_ambient,
+                    double* jacobian_tangent, double* jacobian_brightness) const;
+
   using IntensityGrid = ceres::Grid2D<float, 1>;
   using BicubicInterpolator = ceres::BiCubicInterpolator<IntensityGrid>;
 

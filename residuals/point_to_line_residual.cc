@@ -104,6 +104,12 @@ bool PointToLineResidual::Evaluate(double const* const* parameters, double* resi
   return true;
 }
 
+bool PointToLineResidual::EvaluatePoseTangent(double const* const* parameters, double* residuals,
+                                              double* jacobian_tangent) const {
+  EvaluateTangent(PoseFromParameters(parameters[0]), residuals, jacobian_tangent, valid_.data());
+  return true;
+}
+
 void PointToLineResidual::EvaluateTangent(const SE3& cur_from_ref, double* residuals,
                                           double* jacobian_tangent, std::uint8_t* valid) const {
   const Eigen::Matrix3d rotation = cur_from_ref.rotation_matrix();

@@ -37,6 +37,7 @@
 
 #include "core/pinhole_camera.h"
 #include "core/se3.h"
+#include "residuals/pose_tangent_cost_function.h"
 
 namespace pldvo {
 
@@ -54,7 +55,7 @@ struct PointToLineObservation {
   double sqrt_info = 1.0;                                  // 1 / sqrt(Sigma_g) in 1/px, >= 0
 };
 
-class PointToLineResidual : public ceres::CostFunction {
+class PointToLineResidual : public ceres::CostFunction, public PoseTangentCostFunction {
  public:
   // `camera` is the camera of the level the pixels and lines are expressed in. Throws
   // std::invalid_argument on an empty batch, an invalid camera, |a^2 + b^2 - 1| > 1e-6, a
@@ -73,6 +74,9 @@ class PointToLineResidual : public ceres::CostFunction {
   // parameters[0] = cur_from_ref (7). jacobians[0], if requested, is N x 7 row-major.
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
+  // The rows of Evaluate() with the pose Jacobian in the tangent space (N x 6 row-major).
+  bool EvaluatePoseTangent(double const* const* parameters, double* residuals,
+                           double* jacobian_tangent) const override;
 
   // Tangent-space evaluation (N x 6 row-major Jacobian, may be nullptr; `valid` may be nullptr).
   void EvaluateTangent(const SE3& cur_from_ref, double* residuals, double* jacobian_tangent,

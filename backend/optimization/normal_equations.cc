@@ -4,6 +4,9 @@
 #include <cmath>
 #include <vector>
 
+#include "residuals/pose_tangent_cost_function.h"
+#include "residuals/se3_manifold.h"
+
 namespace pldvo {
 namespace {
 
@@ -25,6 +28,22 @@ NormalEquations::NormalEquations(const LeastSquaresProblem& problem) : problem_(
     plus_jacobian_[i].resize(blocks[i].size * blocks[i].TangentSize());
     ambient_jacobian_[i].resize(static_cast<size_t>(max_rows) * blocks[i].size);
     tangent_jacobian_[i].resize(static_cast<size_t>(max_rows) * blocks[i].TangentSize());
+  }
+  // Blocks whose only variable parameter block is their first, an SE3Manifold pose, and whose
+  // cost function gives the tangent Jacobian directly.
+  const auto& residual_blocks = problem.residual_blocks();
+  pose_tangent_.assign(residual_blocks.size(), nullptr);
+  for (size_t b = 0; b < residual_blocks.size(); ++b) {
+    const std::vector<int>& indices = residual_blocks[b].parameter_block_indices;
+    const auto* cost =
+        dynamic_cast<const PoseTangentCostFunction*>(residual_blocks[b].cost_function);
+    if (cost == nullptr || indices.empty() || tangent_offset_[indices[0]] < 0 ||
+        dynamic_cast<const SE3Manifold*>(blocks[indices[0]].manifold) == nullptr) {
+      continue;
+    }
+    const bool others_constant = std::all_of(indices.begin() + 1, indices.end(),
+                                             [&](int index) { return tangent_offset_[index] < 0; });
+    if (others_constant) pose_tangent_[b] = cost;
   }
   residuals_.resize(max_rows);
   row_.resize(dimension_);
@@ -48,17 +67,28 @@ bool NormalEquations::Linearize(double* cost) {
   hessian_.setZero();
   gradient_.setZero();
   double total_cost = 0.0;
-  for (const LeastSquaresProblem::ResidualBlock& block : problem_.residual_blocks()) {
+  const auto& residual_blocks = problem_.residual_blocks();
+  for (size_t b = 0; b < residual_blocks.size(); ++b) {
+    const LeastSquaresProblem::ResidualBlock& block = residual_blocks[b];
     const int rows = block.cost_function->num_residuals();
     const int num_blocks = static_cast<int>(block.parameter_block_indices.size());
-    for (int k = 0; k < num_blocks; ++k) {
-      const int index = block.parameter_block_indices[k];
-      jacobian_pointers_[k] =
-          tangent_offset_[index] >= 0 ? ambient_jacobian_[index].data() : nullptr;
-    }
-    if (!block.cost_function->Evaluate(block.parameters.data(), residuals_.data(),
-                                       jacobian_pointers_.data())) {
-      return false;
+    const PoseTangentCostFunction* pose_tangent = pose_tangent_[b];
+    if (pose_tangent != nullptr) {
+      double* jacobian = tangent_jacobian_[block.parameter_block_indices[0]].data();
+      if (!pose_tangent->EvaluatePoseTangent(block.parameters.data(), residuals_.data(),
+                                             jacobian)) {
+        return false;
+      }
+    } else {
+      for (int k = 0; k < num_blocks; ++k) {
+        const int index = block.parameter_block_indices[k];
+        jacobian_pointers_[k] =
+            tangent_offset_[index] >= 0 ? ambient_jacobian_[index].data() : nullptr;
+      }
+      if (!block.cost_function->Evaluate(block.parameters.data(), residuals_.data(),
+                                         jacobian_pointers_.data())) {
+        return false;
+      }
     }
     double sq_norm = 0.0;
     for (int r = 0; r < rows; ++r) sq_norm += residuals_[r] * residuals_[r];
@@ -94,10 +124,13 @@ bool NormalEquations::Linearize(double* cost) {
       last_variable = index;
       const int ambient = problem_.parameter_blocks()[index].size;
       const int tangent = problem_.parameter_blocks()[index].TangentSize();
-      Eigen::Map<const RowMajorMatrix> plus(plus_jacobian_[index].data(), ambient, tangent);
-      Eigen::Map<const RowMajorMatrix> jac_ambient(ambient_jacobian_[index].data(), rows, ambient);
       Eigen::Map<RowMajorMatrix> jac_tangent(tangent_jacobian_[index].data(), rows, tangent);
-      jac_tangent.noalias() = jac_ambient * plus;
+      if (pose_tangent == nullptr) {
+        Eigen::Map<const RowMajorMatrix> plus(plus_jacobian_[index].data(), ambient, tangent);
+        Eigen::Map<const RowMajorMatrix> jac_ambient(ambient_jacobian_[index].data(), rows,
+                                                     ambient);
+        jac_tangent.noalias() = jac_ambient * plus;
+      }
       if (alpha_sq_norm != 0.0) {
         // J <- J - alpha/s r (r^T J).
         Eigen::Map<const Eigen::VectorXd> r(residuals_.data(), rows);

@@ -7,9 +7,11 @@
 #define PLDVO_BACKEND_OPTIMIZATION_NORMAL_EQUATIONS_H_
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <vector>
 
 #include "backend/optimization/least_squares_problem.h"
+#include "residuals/pose_tangent_cost_function.h"
 
 namespace pldvo {
 
@@ -22,6 +24,11 @@ class NormalEquations {
   // Offset of parameter block `index` in the tangent vector; -1 for a constant block.
   int TangentOffset(int index) const { return tangent_offset_[index]; }
   const Eigen::MatrixXd& hessian() const { return hessian_; }
+  // Residual blocks whose rows come in the pose tangent directly (PoseTangentCostFunction).
+  int num_pose_tangent_blocks() const {
+    return static_cast<int>(pose_tangent_.size()) -
+           static_cast<int>(std::count(pose_tangent_.begin(), pose_tangent_.end(), nullptr));
+  }
   const Eigen::VectorXd& gradient() const { return gradient_; }
 
   // Evaluates cost, H and g at the current parameters; false when an evaluation fails.
@@ -38,6 +45,9 @@ class NormalEquations {
   std::vector<std::vector<double>> plus_jacobian_;  // ambient x tangent, row-major
   std::vector<std::vector<double>> ambient_jacobian_;
   std::vector<std::vector<double>> tangent_jacobian_;
+  // Per residual block: its cost function when it gives the pose's tangent Jacobian directly
+  // (PoseTangentCostFunction) and the pose is its only variable block; nullptr otherwise.
+  std::vector<const PoseTangentCostFunction*> pose_tangent_;
   std::vector<double> residuals_;
   std::vector<double> row_;
   std::vector<int> columns_;  // tangent columns of one residual block's variable blocks, sorted
