@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/random_draws.h"
+#include "core/statistics.h"
 #include "tests/residuals/residual_test_utils.h"
 
 namespace pldvo {
@@ -276,6 +277,34 @@ TEST(IntensityNoise, ScalesWithContrastSoTheWeightRatioDoesNot) {
     const double fixed_photometric =
         PhotometricSqrtInfo(options, contrast * gradient, idepth_jacobian, idepth_var);
     EXPECT_GT(std::abs(fixed_photometric * contrast - photometric), 0.05 * photometric);
+  }
+}
+
+TEST(IntensityNoise, IsTheRootOfTheRobustScaleEquation) {
+  // sigma solves 1.4826 median(|e_i| / sqrt(k sigma^2 + D_i)) = 1; the reference root is a
+  // plain bisection in log sigma to a relative bracket of 1e-14.
+  for (const unsigned seed : {1u, 2u, 3u}) {
+    for (const int rows : {kMinIntensityNoiseRows, 301, 4000}) {
+      const NoiseSample sample = DrawErrors(5.0, 2.0, rows, seed);
+      const auto scale = [&](double sigma) {
+        std::vector<double> whitened;
+        for (int i = 0; i < rows; ++i) {
+          whitened.push_back(std::abs(sample.errors[i]) /
+                             std::sqrt(2.0 * sigma * sigma + sample.other_variances[i]));
+        }
+        return 1.4826 * Median(whitened);
+      };
+      double low = 1e-3, high = 1e3;
+      ASSERT_GT(scale(low), 1.0);
+      ASSERT_LT(scale(high), 1.0);
+      while (std::log(high / low) > 1e-14) {
+        const double mid = std::sqrt(low * high);
+        (scale(mid) > 1.0 ? low : high) = mid;
+      }
+      EXPECT_NEAR(EstimateIntensityNoiseSigma(sample.errors, sample.other_variances, 2.0), low,
+                  1e-11 * low)
+          << "seed " << seed << ", rows " << rows;
+    }
   }
 }
 
