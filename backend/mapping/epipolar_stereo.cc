@@ -217,9 +217,18 @@ StereoStatus SearchEpipolarSsd(const ImagePyramid& current, const EpipolarGeomet
   const int num_samples = num_steps + 4 * n;
   if (num_samples > kMaxSamples) return StereoStatus::kSearchTooLong;
   float samples[kMaxSamples];
+  // The image is convex: with both ends inside (with a margin for rounding) so is every sample,
+  // and the per-sample test can go.
+  const Eigen::Vector2d first = start - (2 * n) * direction;
+  const Eigen::Vector2d last = start + (num_samples - 1 - 2 * n) * direction;
+  constexpr double kMargin = 1e-6;
+  const bool inside = current.CanSample(0, first.x() - kMargin, first.y() - kMargin) &&
+                      current.CanSample(0, first.x() + kMargin, first.y() + kMargin) &&
+                      current.CanSample(0, last.x() - kMargin, last.y() - kMargin) &&
+                      current.CanSample(0, last.x() + kMargin, last.y() + kMargin);
   for (int m = 0; m < num_samples; ++m) {
     const Eigen::Vector2d p = start + (m - 2 * n) * direction;
-    if (!current.CanSample(0, p.x(), p.y())) return StereoStatus::kTruncated;
+    if (!inside && !current.CanSample(0, p.x(), p.y())) return StereoStatus::kTruncated;
     samples[m] = current.SampleIntensity(0, p.x(), p.y());
   }
   double ssd[kMaxSamples];
