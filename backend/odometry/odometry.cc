@@ -634,7 +634,9 @@ TrackingResult Odometry::TrackFrame(const ImagePyramid& pyramid, const cv::Mat& 
     result->num_line_outliers += outliers;
     if (outliers > 0) {
       TrackingResult again =
-          tracker_.Track(reference_, pyramid, tracking.cur_from_ref, tracking.brightness);
+          config_.odometry.line_outlier_refine_finest
+              ? tracker_.Refine(reference_, pyramid, tracking.cur_from_ref, tracking.brightness)
+              : tracker_.Track(reference_, pyramid, tracking.cur_from_ref, tracking.brightness);
       if (again.status != TrackingStatus::kLost) tracking = std::move(again);
     }
   }
@@ -655,8 +657,15 @@ TrackingResult Odometry::TrackFrame(const ImagePyramid& pyramid, const cv::Mat& 
 void Odometry::CompareSolvers(const ImagePyramid& pyramid, const TrackingResult& tracking,
                               OdometryFrameResult* result) {
   const auto start = WallClock::now();
+  // The same solve from the same start: a refinement after unmatching lines (finest level
+  // only) or the coarse-to-fine track.
+  const bool refined = tracking.levels.size() == 1 &&
+                       config_.tracking.coarsest_level > config_.tracking.finest_level;
   const TrackingResult other =
-      compare_tracker_->Track(reference_, pyramid, tracking.initial_cur_from_ref, brightness_);
+      refined ? compare_tracker_->Refine(reference_, pyramid, tracking.initial_cur_from_ref,
+                                         tracking.initial_brightness)
+              : compare_tracker_->Track(reference_, pyramid, tracking.initial_cur_from_ref,
+                                        tracking.initial_brightness);
   result->timing.compare_tracking_ms = MsSince(start);
   result->compared = true;
   result->compared_status = other.status;

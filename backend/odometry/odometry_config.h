@@ -85,6 +85,9 @@ struct OdometryOptions {
   // and the frame is tracked again from the result. The same unmatched lines are withheld from
   // the line-guided stereo. 0 = off.
   double line_outlier_px = 2.0;
+  // The track again after unmatching: the finest level only from the tracked pose
+  // (Tracker::Refine), or coarse to fine as the first track (false).
+  bool line_outlier_refine_finest = true;
   // The same check before tracking at the constant-velocity prior, with this looser gate (the
   // prior is off by the acceleration since the last frame); 0 = off.
   double line_prior_gate_px = 2.0;
@@ -178,6 +181,9 @@ struct OdometryOptions {
     v.Field("line_outlier_px", &line_outlier_px,
             "Unmatch lines whose edge points reproject at a median distance above this (px) "
             "after tracking, and track again; 0 = off (default 2).");
+    v.Field("line_outlier_refine_finest", &line_outlier_refine_finest,
+            "After unmatching lines (line_outlier_px), re-solve only the finest level from the "
+            "tracked pose; false re-tracks coarse to fine (default true).");
     v.Field("line_consensus_max_cost_drop", &line_consensus_max_cost_drop,
             "Drop a frame's line term when a photometric-only solve from its result lowers the "
             "photometric cost by more than this (0.5 sum r^2; 0 = off).");

@@ -195,13 +195,27 @@ TrackingResult Tracker::Track(const TrackingReference& reference, const ImagePyr
                               const SE3& initial_cur_from_ref,
                               const AffineBrightness& initial_brightness,
                               const TrackingIterationCallback& callback) const {
+  return TrackLevels(reference, current, initial_cur_from_ref, initial_brightness, callback,
+                     options_.coarsest_level);
+}
+
+TrackingResult Tracker::Refine(const TrackingReference& reference, const ImagePyramid& current,
+                               const SE3& cur_from_ref, const AffineBrightness& brightness) const {
+  return TrackLevels(reference, current, cur_from_ref, brightness, nullptr, options_.finest_level);
+}
+
+TrackingResult Tracker::TrackLevels(const TrackingReference& reference, const ImagePyramid& current,
+                                    const SE3& initial_cur_from_ref,
+                                    const AffineBrightness& initial_brightness,
+                                    const TrackingIterationCallback& callback,
+                                    int coarsest_level) const {
   const int available = std::min(reference.num_levels(), current.num_levels());
   if (available <= options_.finest_level) {
     throw std::invalid_argument(Where(__LINE__) + "finest_level " +
                                 std::to_string(options_.finest_level) + " but only " +
                                 std::to_string(available) + " levels available");
   }
-  const int coarsest = std::min(options_.coarsest_level, available - 1);
+  const int coarsest = std::min(coarsest_level, available - 1);
 
   double pose[kPoseAmbientSize];
   PoseToParameters(initial_cur_from_ref, pose);
@@ -209,6 +223,7 @@ TrackingResult Tracker::Track(const TrackingReference& reference, const ImagePyr
   const auto start = WallClock::now();
   TrackingResult result;
   result.initial_cur_from_ref = initial_cur_from_ref;
+  result.initial_brightness = initial_brightness;
   for (int level = coarsest; level >= options_.finest_level; --level) {
     LeastSquaresProblem problem;
     const BuildStatistics built =

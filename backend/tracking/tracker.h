@@ -114,8 +114,9 @@ struct TrackingResult {
   // The current frame's brightness relative to the reference (tracking.problem.brightness
   // affine; the initial guess, unchanged, with none).
   AffineBrightness brightness;
-  SE3 initial_cur_from_ref;  // the initial guess this result was solved from
-  double ms = 0.0;           // wall time of the Track call
+  SE3 initial_cur_from_ref;             // the initial guess this result was solved from
+  AffineBrightness initial_brightness;  // and brightness
+  double ms = 0.0;                      // wall time of the Track call
   TrackingStatus status = TrackingStatus::kLost;
   std::vector<LevelResult> levels;     // in the order solved (coarse to fine)
   int valid_residuals = 0;             // at the final pose, finest level
@@ -161,9 +162,21 @@ class Tracker {
                        const AffineBrightness& initial_brightness = AffineBrightness(),
                        const TrackingIterationCallback& callback = nullptr) const;
 
+  // Track() over the finest level only, from a pose already tracked on the same reference: the
+  // coarse levels widen the basin of convergence, which a converged pose does not need (the
+  // odometry re-solves with it after unmatching wrong line matches).
+  TrackingResult Refine(const TrackingReference& reference, const ImagePyramid& current,
+                        const SE3& cur_from_ref, const AffineBrightness& brightness) const;
+
   const TrackingOptions& options() const { return options_; }
 
  private:
+  // Track() from `coarsest_level` (clamped to the pyramids) down to the finest level.
+  TrackingResult TrackLevels(const TrackingReference& reference, const ImagePyramid& current,
+                             const SE3& initial_cur_from_ref,
+                             const AffineBrightness& initial_brightness,
+                             const TrackingIterationCallback& callback, int coarsest_level) const;
+
   // TrackingResult::intensity_noise_sigma from the finest level's statistics.
   double IntensityNoiseAtSolution(const TrackingReference& reference,
                                   const ResidualStatistics& stats) const;

@@ -278,7 +278,9 @@ TEST(OdometryTest, FramesWhoseLineTermWasDroppedAreNotCompared) {
     dropped += frame.line_term_dropped;
     EXPECT_EQ(frame.compared, !frame.line_term_dropped) << "frame " << frame.index;
     // The check's solve is timed as a part of tracking.
-    if (frame.num_matches > 0) EXPECT_GT(frame.timing.consensus_ms, 0.0) << frame.index;
+    if (frame.num_matches > 0) {
+      EXPECT_GT(frame.timing.consensus_ms, 0.0) << frame.index;
+    }
     EXPECT_LE(frame.timing.consensus_ms, frame.timing.tracking_ms) << "frame " << frame.index;
   }
   EXPECT_GT(dropped, 0);

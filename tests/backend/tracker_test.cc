@@ -679,6 +679,32 @@ TEST(TrackerTest, AffineBrightnessRecoversPoseGainAndBias) {
 // matches stands. A joint result that wrong matches dragged 5 mm off (the pose a repetitive
 // pattern's neighbouring lines pull towards) is caught: the photometric-only solve from it drops
 // the cost by far more than chi^2 allows, and its pose is the photometric one, near the truth.
+// Refine solves the finest level alone, from a pose near the solution (the odometry's re-solve
+// after unmatching lines): it reaches the pose that coarse-to-fine tracking reaches.
+TEST(TrackerTest, RefineSolvesTheFinestLevelFromANearbyPose) {
+  const FramePair& pair = Pair("textured");
+  const ImagePyramid current(pair.cur_image, 4);
+  const TrackingOptions options =
+      ModeOptions(Mode::kBoth, SolverOptions::Type::kGaussNewton, ImageInterpolation::kBilinear);
+  const TrackingReference reference =
+      MakePairReference(pair, GroundTruthReferenceOptions(), /*with_edges=*/true);
+  const Tracker tracker(options);
+  const SE3 nearby =
+      SE3::Exp((Vector6d() << 0.004, -0.002, 0.0, 0.0, 0.001, 0.0).finished()) * pair.cur_from_ref;
+  const TrackingResult refined = tracker.Refine(reference, current, nearby, AffineBrightness());
+  ASSERT_EQ(refined.levels.size(), 1u);
+  EXPECT_EQ(refined.levels[0].level, options.finest_level);
+  EXPECT_NE(refined.status, TrackingStatus::kLost);
+  EXPECT_EQ(refined.initial_cur_from_ref.translation(), nearby.translation());
+  // The RecoversTheRelativePose bounds, which the coarse-to-fine result meets too: the two
+  // within half of that bound of each other.
+  EXPECT_LT(TranslationError(refined.cur_from_ref, pair.cur_from_ref), 1e-3);
+  EXPECT_LT(RotationErrorDeg(refined.cur_from_ref, pair.cur_from_ref), 0.05);
+  const TrackingResult tracked = tracker.Track(reference, current, SE3());
+  ASSERT_EQ(static_cast<int>(tracked.levels.size()), options.coarsest_level + 1);
+  EXPECT_LT(TranslationError(refined.cur_from_ref, tracked.cur_from_ref), 0.5e-3);
+}
+
 TEST(PhotometricConsensusTest, KeepsATrueLineTermAndDropsOneThatDraggedThePose) {
   const FramePair& pair = Pair("textured");
   const ImagePyramid current(pair.cur_image, 4);
