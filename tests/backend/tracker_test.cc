@@ -674,20 +674,21 @@ TEST(TrackerTest, AffineBrightnessRecoversPoseGainAndBias) {
   EXPECT_EQ(plain.brightness.b, 0.0);
 }
 
-// The photometric consensus check (backend/tracking/photometric_consensus.h) on the textured
-// pair, whose image constrains every direction of the pose. The joint solve with the true line
-// matches stands. A joint result that wrong matches dragged 5 mm off (the pose a repetitive
-// pattern's neighbouring lines pull towards) is caught: the photometric-only solve from it drops
-// the cost by far more than chi^2 allows, and its pose is the photometric one, near the truth.
-// Refine solves the finest level alone, from a pose near the solution (the odometry's re-solve
-// after unmatching lines): it reaches the pose that coarse-to-fine tracking reaches.
-TEST(TrackerTest, RefineSolvesTheFinestLevelFromANearbyPose) {
+// The textured pair with ground-truth points and lines, for the joint (points and lines) solve.
+struct TexturedJoint {
   const FramePair& pair = Pair("textured");
-  const ImagePyramid current(pair.cur_image, 4);
+  const ImagePyramid current{pair.cur_image, 4};
   const TrackingOptions options =
       ModeOptions(Mode::kBoth, SolverOptions::Type::kGaussNewton, ImageInterpolation::kBilinear);
   const TrackingReference reference =
       MakePairReference(pair, GroundTruthReferenceOptions(), /*with_edges=*/true);
+};
+
+// Refine solves the finest level alone, from a pose near the solution (the odometry's re-solve
+// after unmatching lines): it reaches the pose that coarse-to-fine tracking reaches.
+TEST(TrackerTest, RefineSolvesTheFinestLevelFromANearbyPose) {
+  const TexturedJoint joint_problem;
+  const auto& [pair, current, options, reference] = joint_problem;
   const Tracker tracker(options);
   const SE3 nearby =
       SE3::Exp((Vector6d() << 0.004, -0.002, 0.0, 0.0, 0.001, 0.0).finished()) * pair.cur_from_ref;
@@ -705,13 +706,14 @@ TEST(TrackerTest, RefineSolvesTheFinestLevelFromANearbyPose) {
   EXPECT_LT(TranslationError(refined.cur_from_ref, tracked.cur_from_ref), 0.5e-3);
 }
 
+// The photometric consensus check (backend/tracking/photometric_consensus.h) on the textured
+// pair, whose image constrains every direction of the pose. The joint solve with the true line
+// matches stands. A joint result that wrong matches dragged 5 mm off (the pose a repetitive
+// pattern's neighbouring lines pull towards) is caught: the photometric-only solve from it drops
+// the cost by far more than chi^2 allows, and its pose is the photometric one, near the truth.
 TEST(PhotometricConsensusTest, KeepsATrueLineTermAndDropsOneThatDraggedThePose) {
-  const FramePair& pair = Pair("textured");
-  const ImagePyramid current(pair.cur_image, 4);
-  const TrackingOptions options =
-      ModeOptions(Mode::kBoth, SolverOptions::Type::kGaussNewton, ImageInterpolation::kBilinear);
-  const TrackingReference reference =
-      MakePairReference(pair, GroundTruthReferenceOptions(), /*with_edges=*/true);
+  const TexturedJoint joint_problem;
+  const auto& [pair, current, options, reference] = joint_problem;
   // chi^2_6 at 99% / 2.
   const PhotometricConsensus consensus(options, 8.4);
 
