@@ -81,8 +81,8 @@ double EstimateIntensityNoiseSigma(const std::vector<double>& errors,
   if (excess_low <= 0.0) return low;
   // scale(sigma) = 1 in x = log sigma on [log low, log s0] (excess > 0 at a, <= 0 at b): regula
   // falsi with the Illinois modification, which keeps both ends moving. The median of smooth
-  // functions is piecewise smooth, so it converges superlinearly: 6-12 medians instead of the
-  // 41 of bisection, to the same relative bracket of 1e-12.
+  // functions is piecewise smooth, so it converges superlinearly: far fewer medians than the 40
+  // of bisection, to the same relative bracket of 1e-12.
   double a = std::log(low), b = std::log(s0);
   double excess_a = excess_low, excess_b = scale(s0) - 1.0;
   int kept_side = 0;  // +1: a was kept by the last step, -1: b was
