@@ -10,7 +10,7 @@
 # synthetic family at PLDVO_DEV_SEEDS, default "1 2 3", 640x480, and fr1/rpy and KITTI 00 when
 # present), PLDVO_DEV_FRAMES frames (default 300), PLDVO_DEV_FILTER an extended regex on the
 # sequence names. Both: PLDVO_DEV_REPEATS initial maps (default 3; mapping.init_seed 1..R),
-# inline mapping (deterministic), PLDVO_DEV_JOBS runs at a time. The full set is 36 configs x 35
+# inline mapping (deterministic), PLDVO_DEV_JOBS runs at a time. The full set is 38 configs x 35
 # sequences x R maps: a cluster job (docs/cluster.md; the grid's configs are in $dir/configs after
 # the first step).
 # Needs python3 with PyYAML (Debian: python3-yaml, which scripts/install_deps.sh installs) to
@@ -80,6 +80,7 @@ post_line_gate	odometry.line_outlier_px=2	odometry.line_outlier_px=0	The same ch
 predicted_matching	odometry.predict_line_matches=true	odometry.predict_line_matches=false	Matches lines near their homography-predicted position (tighter radius and angle gates).
 two_view_bootstrap	odometry.two_view_bootstrap=true	odometry.two_view_bootstrap=false	Starts from frame 0's map of a two-view geometry of tracked corners instead of the random map; where it fails the run starts as without it (docs/bootstrap.md).
 consensus_check	odometry.line_consensus_max_cost_drop=8.4	odometry.line_consensus_max_cost_drop=0	Drops a frame's line term when a photometric-only solve from its result lowers the photometric cost by more than chi^2_6(0.99)/2: wrong line matches (repetitive patterns, occlusion edges) cannot drag the pose (docs/tracking.md).
+estimated_noise	tracking.problem.weighting.intensity_noise=estimated	tracking.problem.weighting.intensity_noise=fixed	sigma_I of eq. 5 estimated from the previous frame's photometric errors instead of a fixed 4 gray levels: the ratio of photometric to point-to-line weights does not move with the camera's contrast (docs/tracking.md).
 alternative_poses	odometry.try_alternatives=true	odometry.try_alternatives=false	Retries lost or high-residual frames from zero motion and small rotations.
 point_budget_4000	mapping.max_reference_points=4000	mapping.max_reference_points=0	At most 4000 tracking reference points per pyramid level: bounds the tracking time.
 no_line_regularisation	mapping.line_regularization=false	mapping.line_regularization=true	Leaves out the paper's 3D line regularisation (eqs. 11-13), which made points_lines worse on most of the development set (docs/mapping.md).

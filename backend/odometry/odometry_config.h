@@ -303,8 +303,12 @@ struct BackendOptions {
 
 struct OdometryConfig {
   // Defaults of the sub-structs, except the line detector: EDLines (at 640x480 about 4x faster
-  // than LSD; measured in docs/odometry.md).
-  OdometryConfig() { lines.detector.method = LineDetectorOptions::Method::kEdLines; }
+  // than LSD; measured in docs/odometry.md), and tracking's image noise, estimated from the
+  // residuals so that the balance of eqs. 5-6 does not move with the contrast (docs/tracking.md).
+  OdometryConfig() {
+    lines.detector.method = LineDetectorOptions::Method::kEdLines;
+    tracking.problem.weighting.intensity_noise = IntensityNoiseSource::kEstimated;
+  }
 
   DatasetOptions dataset;
   LineFrontendOptions lines;

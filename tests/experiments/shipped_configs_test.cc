@@ -63,6 +63,8 @@ void ExpectExtras(const OdometryConfig& config, bool on, const std::string& name
   EXPECT_EQ(config.odometry.try_alternatives, on);
   EXPECT_EQ(config.odometry.two_view_bootstrap, on);
   EXPECT_EQ(config.odometry.line_consensus_max_cost_drop, on ? 8.4 : 0.0);
+  EXPECT_EQ(config.tracking.problem.weighting.intensity_noise,
+            on ? IntensityNoiseSource::kEstimated : IntensityNoiseSource::kFixed);
 }
 
 // Per shipped file: what its header comment says it turns on.
@@ -111,6 +113,7 @@ const std::map<std::string, std::function<void(const OdometryConfig&)>>& Cases()
          EXPECT_FALSE(c.mapping.use_line_stereo);
          EXPECT_FALSE(c.mapping.line_regularization);
          EXPECT_TRUE(c.odometry.two_view_bootstrap);  // the same start as points_lines
+         EXPECT_EQ(c.tracking.problem.weighting.intensity_noise, IntensityNoiseSource::kFixed);
        }},
       {"lines_only",
        [](const OdometryConfig& c) {
