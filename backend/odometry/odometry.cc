@@ -657,15 +657,14 @@ TrackingResult Odometry::TrackFrame(const ImagePyramid& pyramid, const cv::Mat& 
 void Odometry::CompareSolvers(const ImagePyramid& pyramid, const TrackingResult& tracking,
                               OdometryFrameResult* result) {
   const auto start = WallClock::now();
-  // The same solve from the same start: a refinement after unmatching lines (finest level
-  // only) or the coarse-to-fine track.
-  const bool refined = tracking.levels.size() == 1 &&
-                       config_.tracking.coarsest_level > config_.tracking.finest_level;
+  // The same solve from the same start. One level solved: a refinement after unmatching lines,
+  // or a track whose coarsest level is the finest (Refine solves the same); else coarse to fine.
   const TrackingResult other =
-      refined ? compare_tracker_->Refine(reference_, pyramid, tracking.initial_cur_from_ref,
-                                         tracking.initial_brightness)
-              : compare_tracker_->Track(reference_, pyramid, tracking.initial_cur_from_ref,
-                                        tracking.initial_brightness);
+      tracking.levels.size() == 1
+          ? compare_tracker_->Refine(reference_, pyramid, tracking.initial_cur_from_ref,
+                                     tracking.initial_brightness)
+          : compare_tracker_->Track(reference_, pyramid, tracking.initial_cur_from_ref,
+                                    tracking.initial_brightness);
   result->timing.compare_tracking_ms = MsSince(start);
   result->compared = true;
   result->compared_status = other.status;
