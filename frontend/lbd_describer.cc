@@ -66,6 +66,20 @@ cv::Mat LbdDescriber::Describe(const cv::Mat& image_u8, const std::vector<LineSe
   return descriptors;
 }
 
+void LbdDescriber::DescribeRows(const cv::Mat& image_u8, const std::vector<LineSegment>& segments,
+                                const std::vector<int>& rows, cv::Mat* descriptors) {
+  if (descriptors->rows != static_cast<int>(segments.size()) || descriptors->cols != 32 ||
+      descriptors->type() != CV_8U) {
+    throw std::invalid_argument(std::string(__FILE__) + ":" + std::to_string(__LINE__) +
+                                ": descriptors must be a segments.size() x 32 CV_8U matrix");
+  }
+  std::vector<LineSegment> subset;
+  subset.reserve(rows.size());
+  for (int row : rows) subset.push_back(segments.at(row));
+  const cv::Mat described = Describe(image_u8, subset);
+  for (size_t k = 0; k < rows.size(); ++k) described.row(k).copyTo(descriptors->row(rows[k]));
+}
+
 int HammingDistance32(const uint8_t* a, const uint8_t* b) {
   int distance = 0;
   for (int k = 0; k < 4; ++k) {

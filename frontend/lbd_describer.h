@@ -28,6 +28,12 @@ class LbdDescriber {
   // full-resolution image. Not thread-safe (BinaryDescriptor keeps its pyramid as state).
   cv::Mat Describe(const cv::Mat& image_u8, const std::vector<LineSegment>& segments);
 
+  // Describes segments[rows[k]] into row rows[k] of `descriptors` (segments.size() x 32, CV_8U);
+  // each row is the one Describe gives for the whole list (a descriptor depends on its segment
+  // and the image only).
+  void DescribeRows(const cv::Mat& image_u8, const std::vector<LineSegment>& segments,
+                    const std::vector<int>& rows, cv::Mat* descriptors);
+
   // The KeyLines handed to BinaryDescriptor (exposed for tests).
   std::vector<cv::line_descriptor::KeyLine> MakeKeyLines(const std::vector<LineSegment>& segments,
                                                          const cv::Size& image_size) const;

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <numeric>
 #include <stdexcept>
+#include <string>
 
 #include "core/wall_clock.h"
 #include "frontend/line_refiner.h"
@@ -46,20 +48,72 @@ LineFrame LineFrontend::Process(const cv::Mat& image) {
   frame.timing.merging_ms = MsSince(start);
   frame.timing.num_lines = static_cast<int>(frame.segments.size());
 
-  start = WallClock::now();
-  frame.descriptors = describer_.Describe(gray, frame.segments);
-  frame.timing.description_ms = MsSince(start);
+  frame.descriptors = cv::Mat::zeros(static_cast<int>(frame.segments.size()), 32, CV_8U);
+  frame.described.assign(frame.segments.size(), 0);
+  // The caller may reuse an 8-bit input's buffer for its next frame.
+  frame.gray = gray.data == image.data ? gray.clone() : gray;
+  if (!options_.descriptor.on_demand) {
+    std::vector<int> all(frame.segments.size());
+    std::iota(all.begin(), all.end(), 0);
+    Describe(all, &frame);
+  }
+  if (frame.FullyDescribed()) frame.gray.release();
   return frame;
 }
 
-std::vector<LineMatch> LineFrontend::Match(const LineFrame& keyframe, const LineFrame& frame,
+void LineFrontend::Describe(const std::vector<int>& indices, LineFrame* frame) {
+  std::vector<int> missing;
+  for (int i : indices) {
+    if (!frame->described.at(i)) missing.push_back(i);
+  }
+  if (!missing.empty()) {
+    if (frame->gray.empty()) {
+      throw std::invalid_argument(std::string(__FILE__) +
+                                  ": LineFrame has undescribed segments but no image");
+    }
+    const WallClock::time_point start = WallClock::now();
+    describer_.DescribeRows(frame->gray, frame->segments, missing, &frame->descriptors);
+    for (int i : missing) frame->described[i] = 1;
+    frame->timing.description_ms += MsSince(start);
+  }
+  if (frame->FullyDescribed()) frame->gray.release();
+}
+
+std::vector<LineMatch> LineFrontend::Match(LineFrame* keyframe, LineFrame* frame,
                                            const SegmentPredictor& predictor,
-                                           LineFrontendTiming* timing) const {
-  const WallClock::time_point start = WallClock::now();
-  std::vector<LineMatch> matches = matcher_.Match(keyframe.segments, keyframe.descriptors,
-                                                  frame.segments, frame.descriptors, predictor);
+                                           LineFrontendTiming* timing) {
+  WallClock::time_point start = WallClock::now();
+  const std::vector<std::vector<int>> gated =
+      matcher_.Gate(keyframe->segments, frame->segments, predictor);
+  double matching_ms = MsSince(start);
+  // Describe what the descriptor test will read: the frame's gated segments, and the keyframe's
+  // segments at its first need all at once (it is matched against many frames, and every pass
+  // recomputes the descriptor's image pyramid and gradients).
+  std::vector<int> cur_needed;
+  bool ref_needed = false;
+  for (size_t r = 0; r < gated.size(); ++r) {
+    if (gated[r].empty()) continue;
+    ref_needed = ref_needed || !keyframe->described[r];
+    cur_needed.insert(cur_needed.end(), gated[r].begin(), gated[r].end());
+  }
+  std::sort(cur_needed.begin(), cur_needed.end());
+  cur_needed.erase(std::unique(cur_needed.begin(), cur_needed.end()), cur_needed.end());
+  const double described_before = keyframe->timing.description_ms + frame->timing.description_ms;
+  if (ref_needed) {
+    std::vector<int> all(keyframe->segments.size());
+    std::iota(all.begin(), all.end(), 0);
+    Describe(all, keyframe);
+  }
+  Describe(cur_needed, frame);
+  const double description_ms =
+      keyframe->timing.description_ms + frame->timing.description_ms - described_before;
+  start = WallClock::now();
+  std::vector<LineMatch> matches =
+      matcher_.Select(gated, keyframe->descriptors, frame->descriptors, frame->segments.size());
+  matching_ms += MsSince(start);
   if (timing != nullptr) {
-    timing->matching_ms += MsSince(start);
+    timing->description_ms += description_ms;
+    timing->matching_ms += matching_ms;
     timing->num_matches += static_cast<int>(matches.size());
   }
   return matches;

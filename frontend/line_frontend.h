@@ -7,6 +7,7 @@
 #ifndef PLDVO_FRONTEND_LINE_FRONTEND_H_
 #define PLDVO_FRONTEND_LINE_FRONTEND_H_
 
+#include <algorithm>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -36,12 +37,20 @@ struct LineFrontendTiming {
   }
 };
 
-// The lines of one frame.
+// The lines of one frame. With lines.descriptor.on_demand its segments are described when a
+// match needs them (LineFrontend::Match); `gray` is kept for that until every segment is
+// described.
 struct LineFrame {
   cv::Size image_size;
   std::vector<LineSegment> segments;  // merged, longest first
-  cv::Mat descriptors;                // segments.size() x 32, CV_8U
+  cv::Mat descriptors;                // segments.size() x 32, CV_8U; row i valid if described[i]
+  std::vector<char> described;        // one flag per segment
+  cv::Mat gray;                       // the 8-bit image while some segment is undescribed
   LineFrontendTiming timing;          // detection, merging and description of this frame
+
+  bool FullyDescribed() const {
+    return std::find(described.begin(), described.end(), 0) == described.end();
+  }
 };
 
 class LineFrontend {
@@ -49,15 +58,21 @@ class LineFrontend {
   // Throws std::invalid_argument when options.Check() fails.
   explicit LineFrontend(const LineFrontendOptions& options);
 
-  // Detects, merges and describes the lines of an image (CV_32F 0..255 or CV_8U, one channel).
-  // Not thread-safe; use one frontend per thread.
+  // Detects, merges and describes the lines of an image (CV_32F 0..255 or CV_8U, one channel);
+  // with options.descriptor.on_demand the description is left to Match. Not thread-safe; use one
+  // frontend per thread.
   LineFrame Process(const cv::Mat& image);
 
-  // Matches a keyframe's lines into a frame's; adds the matching time and count to `timing`
-  // when given. `predictor` may be empty (see line_matcher.h).
-  std::vector<LineMatch> Match(const LineFrame& keyframe, const LineFrame& frame,
+  // Matches a keyframe's lines into a frame's, first describing what has no descriptor yet: the
+  // frame's segments that pass some geometric gate, and all of the keyframe's once one of them
+  // does; adds the description and matching times and the match count to `timing` when given.
+  // `predictor` may be empty (line_matcher.h).
+  std::vector<LineMatch> Match(LineFrame* keyframe, LineFrame* frame,
                                const SegmentPredictor& predictor = nullptr,
-                               LineFrontendTiming* timing = nullptr) const;
+                               LineFrontendTiming* timing = nullptr);
+
+  // Describes the segments listed in `indices` that have no descriptor yet.
+  void Describe(const std::vector<int>& indices, LineFrame* frame);
 
   // Traces the keyframe lines that appear as ref_index in `matches` (each once).
   EdgeTrace TraceMatched(const LineFrame& keyframe, const std::vector<LineMatch>& matches,

@@ -143,6 +143,11 @@ struct LineDescriptorOptions {
   // proportional to it: 32 halves the description time on textured frames but costs lowtex
   // matches (docs/line_frontend.md, "Cheaper detection and description").
   int max_support_px = 0;
+  // Describe only what matching needs: a frame's segments that some keyframe segment gates
+  // geometrically, and a keyframe's all at once when it first gates one (results are the same;
+  // docs/line_frontend.md, "On demand").
+  // false: Process describes every segment, e.g. when a frontend thread has a core to spare.
+  bool on_demand = true;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
@@ -150,6 +155,9 @@ struct LineDescriptorOptions {
     v.Field("min_octave", &min_octave, "Describe at octave max(detection octave, min_octave).");
     v.Field("max_support_px", &max_support_px,
             "LBD support length along the segment (octave px, centred; 0 = whole segment).");
+    v.Field("on_demand", &on_demand,
+            "Describe only the segments that matching gates; false: all in Process (default "
+            "true).");
   }
   std::string Check() const;
 };

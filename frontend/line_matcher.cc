@@ -48,10 +48,15 @@ std::vector<LineMatch> LineMatcher::Match(const std::vector<LineSegment>& ref_se
                                           const std::vector<LineSegment>& cur_segments,
                                           const cv::Mat& cur_descriptors,
                                           const SegmentPredictor& predictor) const {
-  CheckDescriptors(ref_descriptors, ref_segments.size(), "reference");
-  CheckDescriptors(cur_descriptors, cur_segments.size(), "current");
-  std::vector<LineMatch> matches;
-  if (ref_segments.empty() || cur_segments.empty()) return matches;
+  return Select(Gate(ref_segments, cur_segments, predictor), ref_descriptors, cur_descriptors,
+                cur_segments.size());
+}
+
+std::vector<std::vector<int>> LineMatcher::Gate(const std::vector<LineSegment>& ref_segments,
+                                                const std::vector<LineSegment>& cur_segments,
+                                                const SegmentPredictor& predictor) const {
+  std::vector<std::vector<int>> gated(ref_segments.size());
+  if (ref_segments.empty() || cur_segments.empty()) return gated;
 
   // Bucket grid over the current segments' bounding box; a segment is entered in every cell
   // its body passes through.
@@ -87,12 +92,6 @@ std::vector<LineMatch> LineMatcher::Match(const std::vector<LineSegment>& ref_se
       (predicted ? options_.predicted_max_angle_deg : options_.max_angle_deg) * M_PI / 180.0;
   const int bin_reach = std::min((num_bins - 1) / 2,
                                  static_cast<int>(std::ceil(max_angle / (2.0 * M_PI / num_bins))));
-
-  struct Best {
-    int best = INT_MAX, second = INT_MAX, index = -1;
-  };
-  std::vector<Best> ref_best(ref_segments.size());
-  std::vector<Best> cur_best(cur_segments.size());  // best reference per current segment
   std::vector<int> stamp(cur_segments.size(), -1);
   std::vector<int> candidates;
 
@@ -130,8 +129,6 @@ std::vector<LineMatch> LineMatcher::Match(const std::vector<LineSegment>& ref_se
       }
     }
 
-    const uint8_t* ref_row = ref_descriptors.ptr<uint8_t>(r);
-    Best& best = ref_best[r];
     for (int c : candidates) {
       const LineSegment& cur = cur_segments[c];
       if (AngleDifference(cur.angle, angle) > max_angle) continue;
@@ -139,6 +136,27 @@ std::vector<LineMatch> LineMatcher::Match(const std::vector<LineSegment>& ref_se
       const double a = direction.dot(cur.start - start);
       const double b = direction.dot(cur.end - start);
       if (std::max(a, b) < -radius || std::min(a, b) > length + radius) continue;
+      gated[r].push_back(c);
+    }
+  }
+  return gated;
+}
+
+std::vector<LineMatch> LineMatcher::Select(const std::vector<std::vector<int>>& gated,
+                                           const cv::Mat& ref_descriptors,
+                                           const cv::Mat& cur_descriptors,
+                                           size_t num_cur_segments) const {
+  CheckDescriptors(ref_descriptors, gated.size(), "reference");
+  CheckDescriptors(cur_descriptors, num_cur_segments, "current");
+  struct Best {
+    int best = INT_MAX, second = INT_MAX, index = -1;
+  };
+  std::vector<Best> ref_best(gated.size());
+  std::vector<Best> cur_best(num_cur_segments);  // best reference per current segment
+  for (int r = 0; r < static_cast<int>(gated.size()); ++r) {
+    const uint8_t* ref_row = ref_descriptors.ptr<uint8_t>(r);
+    Best& best = ref_best[r];
+    for (int c : gated[r]) {
       const int distance = HammingDistance32(ref_row, cur_descriptors.ptr<uint8_t>(c));
       if (distance < best.best) {
         best.second = best.best;
@@ -158,7 +176,8 @@ std::vector<LineMatch> LineMatcher::Match(const std::vector<LineSegment>& ref_se
     }
   }
 
-  for (int r = 0; r < static_cast<int>(ref_segments.size()); ++r) {
+  std::vector<LineMatch> matches;
+  for (int r = 0; r < static_cast<int>(gated.size()); ++r) {
     const Best& best = ref_best[r];
     if (best.index < 0 || best.best > options_.max_hamming) continue;
     if (best.second != INT_MAX && best.best >= options_.ratio * best.second) continue;

@@ -43,13 +43,25 @@ class LineMatcher {
   // Throws std::invalid_argument when options.Check() fails.
   explicit LineMatcher(const LineMatcherOptions& options);
 
-  // Matches, in the order of the reference segments. Descriptors are N x 32 CV_8U rows
-  // aligned with their segments. `predictor` may be empty.
+  // Matches, in the order of the reference segments: Gate, then Select. Descriptors are N x 32
+  // CV_8U rows aligned with their segments. `predictor` may be empty.
   std::vector<LineMatch> Match(const std::vector<LineSegment>& ref_segments,
                                const cv::Mat& ref_descriptors,
                                const std::vector<LineSegment>& cur_segments,
                                const cv::Mat& cur_descriptors,
                                const SegmentPredictor& predictor = nullptr) const;
+
+  // The geometric test: per reference segment, the current segments within its direction and
+  // radius gates (no descriptor is read).
+  std::vector<std::vector<int>> Gate(const std::vector<LineSegment>& ref_segments,
+                                     const std::vector<LineSegment>& cur_segments,
+                                     const SegmentPredictor& predictor = nullptr) const;
+
+  // The descriptor test on Gate's candidates: smallest Hamming distance, max_hamming, ratio
+  // and mutual checks. Reads only the rows of gated pairs.
+  std::vector<LineMatch> Select(const std::vector<std::vector<int>>& gated,
+                                const cv::Mat& ref_descriptors, const cv::Mat& cur_descriptors,
+                                size_t num_cur_segments) const;
 
  private:
   LineMatcherOptions options_;

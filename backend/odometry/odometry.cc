@@ -539,7 +539,7 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, PreparedFrame
   }
   result.num_reference_points = map_->num_points;
   result.mean_idepth = map_->mean_idepth;
-  LineAssociation association = MatchKeyframeLines(lines, prior_cur_from_kf, &result);
+  LineAssociation association = MatchKeyframeLines(&lines, prior_cur_from_kf, &result);
   UpdateReference(association.lines_in_cur, &timing);
   TrackingResult tracking =
       TrackFrame(frame.pyramid, frame.image, index, prior_cur_from_kf, &association, &result);
@@ -581,11 +581,11 @@ void Odometry::StartFirstKeyframe(int index, double timestamp, const cv::Mat& im
   result->keyframe_id = keyframe_.id;
 }
 
-Odometry::LineAssociation Odometry::MatchKeyframeLines(const LineFrame& lines,
+Odometry::LineAssociation Odometry::MatchKeyframeLines(LineFrame* lines,
                                                        const SE3& prior_cur_from_kf,
                                                        OdometryFrameResult* result) {
   LineAssociation association;
-  if (frontend_ == nullptr || keyframe_.lines.segments.empty() || lines.segments.empty()) {
+  if (frontend_ == nullptr || keyframe_.lines.segments.empty() || lines->segments.empty()) {
     return association;
   }
   const SegmentPredictor predictor =
@@ -593,11 +593,12 @@ Odometry::LineAssociation Odometry::MatchKeyframeLines(const LineFrame& lines,
           ? MakePredictor(camera_, prior_cur_from_kf, map_->mean_idepth)
           : SegmentPredictor();
   LineFrontendTiming match_timing;
-  association.matches = frontend_->Match(keyframe_.lines, lines, predictor, &match_timing);
+  association.matches = frontend_->Match(&keyframe_.lines, lines, predictor, &match_timing);
   result->timing.matching_ms = match_timing.matching_ms;
+  result->timing.description_ms += match_timing.description_ms;
   result->num_matches = static_cast<int>(association.matches.size());
   association.lines_in_cur = MatchedLinesFromMatches(
-      association.matches, lines.segments, static_cast<int>(keyframe_.lines.segments.size()));
+      association.matches, lines->segments, static_cast<int>(keyframe_.lines.segments.size()));
   return association;
 }
 

@@ -161,8 +161,9 @@ class Odometry {
   // The first frame becomes the keyframe with a random (or `depth`'s) map.
   void StartFirstKeyframe(int index, double timestamp, const cv::Mat& image, LineFrame lines,
                           const cv::Mat& depth, OdometryFrameResult* result);
-  // Step 2: the keyframe's lines matched into the frame, predicted by the pose prior.
-  LineAssociation MatchKeyframeLines(const LineFrame& lines, const SE3& prior_cur_from_kf,
+  // Step 2: the keyframe's lines matched into the frame, predicted by the pose prior (describing
+  // what the match needs first, lines.descriptor.on_demand).
+  LineAssociation MatchKeyframeLines(LineFrame* lines, const SE3& prior_cur_from_kf,
                                      OdometryFrameResult* result);
   // Step 3: the map's tracking reference with the matched current lines.
   void UpdateReference(const std::vector<MatchedLine>& lines_in_cur, OdometryTiming* timing);

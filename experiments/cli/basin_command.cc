@@ -130,13 +130,13 @@ struct MatchCounts {
 TrackingReference FrontendPairReference(const synthetic_pairs::FramePair& pair,
                                         const BasinConfig& config, LineFrontend* frontend,
                                         MatchCounts* counts) {
-  const LineFrame keyframe = frontend->Process(pair.ref_image);
-  const LineFrame frame = frontend->Process(pair.cur_image);
+  LineFrame keyframe = frontend->Process(pair.ref_image);
+  LineFrame frame = frontend->Process(pair.cur_image);
   std::vector<LineMatch> all(keyframe.segments.size());
   for (size_t i = 0; i < all.size(); ++i) all[i].ref_index = static_cast<int>(i);
   const EdgeTrace edges = frontend->TraceMatched(keyframe, all);
   std::vector<LineMatch> kept;
-  for (const LineMatch& m : frontend->Match(keyframe, frame)) {
+  for (const LineMatch& m : frontend->Match(&keyframe, &frame)) {
     const LineMatchTruth truth =
         JudgeLineMatchByDepth(pair.camera, keyframe.segments[m.ref_index], pair.ref_depth,
                               pair.cur_from_ref, frame.segments[m.cur_index]);

@@ -158,7 +158,7 @@ void FrontendLines(const MapEvalConfig& config, const Frame& keyframe,
                    std::vector<std::vector<MatchedLine>>* lines,
                    std::vector<std::vector<char>>* wrong_matches, MapEvalResult* result) {
   LineFrontend frontend(config.lines);
-  const LineFrame keyframe_lines = frontend.Process(keyframe.image);
+  LineFrame keyframe_lines = frontend.Process(keyframe.image);
   std::vector<LineMatch> all(keyframe_lines.segments.size());
   for (size_t i = 0; i < all.size(); ++i) all[i].ref_index = static_cast<int>(i);
   edges->trace = frontend.TraceMatched(keyframe_lines, all);
@@ -174,11 +174,11 @@ void FrontendLines(const MapEvalConfig& config, const Frame& keyframe,
   }
   std::vector<double> offsets;
   for (const Frame& frame : frames) {
-    const LineFrame frame_lines = frontend.Process(frame.image);
+    LineFrame frame_lines = frontend.Process(frame.image);
     const SE3 cur_from_ref = frame.world_from_cam.Inverse() * keyframe.world_from_cam;
     std::vector<LineMatch> kept;
     wrong_matches->emplace_back(keyframe_lines.segments.size(), 0);
-    for (const LineMatch& m : frontend.Match(keyframe_lines, frame_lines)) {
+    for (const LineMatch& m : frontend.Match(&keyframe_lines, &frame_lines)) {
       const LineMatchTruth truth =
           JudgeLineMatchByDepth(camera, keyframe_lines.segments[m.ref_index], keyframe.depth,
                                 cur_from_ref, frame_lines.segments[m.cur_index]);

@@ -144,9 +144,9 @@ TEST(ReferenceBuilderTest, FootPointsReprojectOntoTheMatchedLinesAtTheTruePose) 
   const test::RenderedSequence rendered = test::RenderLowtexSequence(kFrame + 1);
   const PinholeCamera& camera = rendered.sequence.camera;
   LineFrontend frontend{LineFrontendOptions()};
-  const LineFrame keyframe = frontend.Process(rendered.images[0]);
-  const LineFrame frame = frontend.Process(rendered.images[kFrame]);
-  const std::vector<LineMatch> matches = frontend.Match(keyframe, frame);
+  LineFrame keyframe = frontend.Process(rendered.images[0]);
+  LineFrame frame = frontend.Process(rendered.images[kFrame]);
+  const std::vector<LineMatch> matches = frontend.Match(&keyframe, &frame);
   const EdgeTrace edges = frontend.TraceMatched(keyframe, matches);
   DepthMapper mapper(camera, MappingOptions());
   mapper.InitializeKeyframeFromDepth(rendered.images[0], edges, rendered.first_depth, 1e-4);

@@ -55,6 +55,8 @@ class LineFrontendSynthetic : public ::testing::Test {
   static void SetUpTestSuite() {
     g_scenes = new std::vector<SceneData>();
     LineFrontendOptions options;
+    // Every segment described once here: the tests match copies of these frames.
+    options.descriptor.on_demand = false;
     LineFrontend frontend(options);
     LineDetector detector(options.detector);
     LineMergerOptions no_merge = options.merger;
@@ -268,7 +270,8 @@ MatchStats EvaluateMatches(const SceneData& scene, int keyframe, int gap,
     }
     stats.matchable += matchable[r];
   }
-  for (const LineMatch& m : frontend.Match(ref.lines, cur.lines, predictor)) {
+  LineFrame ref_lines = ref.lines, cur_lines = cur.lines;
+  for (const LineMatch& m : frontend.Match(&ref_lines, &cur_lines, predictor)) {
     const MatchOutcome outcome = judge(m.ref_index, m.cur_index);
     stats.correct += outcome == MatchOutcome::kCorrect;
     stats.wrong += outcome == MatchOutcome::kWrong;
@@ -323,7 +326,8 @@ TEST_F(LineFrontendSynthetic, EdgeTracingOfMatchedKeyframeLines) {
   LineFrontend frontend{LineFrontendOptions()};
   for (const SceneData& scene : *g_scenes) {
     const FrameData& ref = scene.frames.at(0);
-    const std::vector<LineMatch> matches = frontend.Match(ref.lines, scene.frames.at(5).lines);
+    LineFrame ref_lines = ref.lines, cur_lines = scene.frames.at(5).lines;
+    const std::vector<LineMatch> matches = frontend.Match(&ref_lines, &cur_lines);
     const EdgeTrace trace = frontend.TraceMatched(ref.lines, matches);
     ASSERT_FALSE(trace.lines.empty());
     std::set<int> matched;

@@ -3,8 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <iostream>
 #include <map>
+#include <numeric>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <set>
@@ -38,8 +40,12 @@ cv::Mat BlocksImage(const Eigen::Vector2d& offset) {
 }
 
 TEST(LineFrontend, ProcessFillsSegmentsDescriptorsAndTiming) {
-  LineFrontend frontend{LineFrontendOptions()};
+  LineFrontendOptions options;
+  options.descriptor.on_demand = false;
+  LineFrontend frontend{options};
   const LineFrame frame = frontend.Process(BlocksImage(Eigen::Vector2d::Zero()));
+  EXPECT_TRUE(frame.FullyDescribed());
+  EXPECT_TRUE(frame.gray.empty());
   // 5 rectangles x 4 sides, at most 1 segment per side after merging (the sides are straight
   // and long, so a second piece would be a merger failure).
   EXPECT_EQ(frame.segments.size(), 20u);
@@ -117,13 +123,13 @@ TEST(LbdDescriber, MaxSupportDescribesTheCentralPartOfTheSegment) {
 TEST(LineMatcher, MatchesTranslatedImage) {
   LineFrontend frontend{LineFrontendOptions()};
   const Eigen::Vector2d shift(14.5, -9.25);
-  const LineFrame ref = frontend.Process(BlocksImage(Eigen::Vector2d::Zero()));
-  const LineFrame cur = frontend.Process(BlocksImage(shift));
+  LineFrame ref = frontend.Process(BlocksImage(Eigen::Vector2d::Zero()));
+  LineFrame cur = frontend.Process(BlocksImage(shift));
   Eigen::Matrix3d translation = Eigen::Matrix3d::Identity();
   translation.topRightCorner<2, 1>() = shift;
   for (const SegmentPredictor& predictor :
        {SegmentPredictor(), PredictorFromHomography(translation)}) {
-    const std::vector<LineMatch> matches = frontend.Match(ref, cur, predictor);
+    const std::vector<LineMatch> matches = frontend.Match(&ref, &cur, predictor);
     // Segments touching the image border after the shift may change; all others must match.
     EXPECT_GE(matches.size(), 18u);
     std::set<int> used;
@@ -138,6 +144,80 @@ TEST(LineMatcher, MatchesTranslatedImage) {
       EXPECT_LE(m.distance, frontend.options().matcher.max_hamming);
     }
   }
+}
+
+TEST(LbdDescriber, RowsOfASubsetEqualThoseOfTheWholeList) {
+  LineFrontendOptions options;
+  options.descriptor.on_demand = false;
+  LineFrontend frontend{options};
+  const cv::Mat image = BlocksImage(Eigen::Vector2d::Zero());
+  const LineFrame frame = frontend.Process(image);
+  ASSERT_GE(frame.segments.size(), 10u);
+  std::vector<int> rows;
+  for (int i = 1; i < static_cast<int>(frame.segments.size()); i += 3) rows.push_back(i);
+  LbdDescriber describer{options.descriptor};
+  cv::Mat subset = cv::Mat::zeros(frame.descriptors.size(), CV_8U);
+  describer.DescribeRows(ToGray8(image), frame.segments, rows, &subset);
+  for (int i = 0; i < subset.rows; ++i) {
+    const bool listed = std::find(rows.begin(), rows.end(), i) != rows.end();
+    EXPECT_EQ(cv::countNonZero(subset.row(i) != frame.descriptors.row(i)) == 0, listed) << i;
+  }
+}
+
+// Descriptions on demand give the matches of describing everything, and describe only the
+// frame's segments that the gates pass: here the predictor drops every odd keyframe segment, so
+// the frame's segments on those edges stay undescribed; the keyframe is described whole.
+TEST(LineFrontend, OnDemandDescriptionMatchesAsDescribingEverything) {
+  const Eigen::Vector2d shift(14.5, -9.25);
+  LineFrontendOptions eager_options;
+  eager_options.descriptor.on_demand = false;
+  LineFrontend eager{eager_options};
+  LineFrontend lazy{LineFrontendOptions()};
+  ASSERT_TRUE(lazy.options().descriptor.on_demand);
+  Eigen::Matrix3d translation = Eigen::Matrix3d::Identity();
+  translation.topRightCorner<2, 1>() = shift;
+  const SegmentPredictor by_translation = PredictorFromHomography(translation);
+  LineFrame ref = eager.Process(BlocksImage(Eigen::Vector2d::Zero()));
+  const LineFrame cur = eager.Process(BlocksImage(shift));
+  std::map<const LineSegment*, int> index_of;
+  for (size_t i = 0; i < ref.segments.size(); ++i) index_of[&ref.segments[i]] = i;
+  const SegmentPredictor even_only = [&](const LineSegment& s, Eigen::Vector2d* a,
+                                         Eigen::Vector2d* b) {
+    const auto it = index_of.find(&s);
+    return it != index_of.end() && it->second % 2 == 0 && by_translation(s, a, b);
+  };
+  LineFrame eager_cur = cur;
+  const std::vector<LineMatch> expected = eager.Match(&ref, &eager_cur, even_only);
+
+  LineFrame lazy_ref = lazy.Process(BlocksImage(Eigen::Vector2d::Zero()));
+  LineFrame lazy_cur = lazy.Process(BlocksImage(shift));
+  EXPECT_FALSE(lazy_ref.gray.empty());
+  EXPECT_EQ(std::count(lazy_cur.described.begin(), lazy_cur.described.end(), 1), 0);
+  index_of.clear();
+  for (size_t i = 0; i < lazy_ref.segments.size(); ++i) index_of[&lazy_ref.segments[i]] = i;
+  LineFrontendTiming timing;
+  const std::vector<LineMatch> matches = lazy.Match(&lazy_ref, &lazy_cur, even_only, &timing);
+  ASSERT_GE(expected.size(), 8u);
+  ASSERT_EQ(matches.size(), expected.size());
+  for (size_t k = 0; k < matches.size(); ++k) {
+    EXPECT_EQ(matches[k].ref_index, expected[k].ref_index);
+    EXPECT_EQ(matches[k].cur_index, expected[k].cur_index);
+    EXPECT_EQ(matches[k].distance, expected[k].distance);
+  }
+  EXPECT_GT(timing.description_ms, 0.0);
+  EXPECT_TRUE(lazy_ref.FullyDescribed());
+  EXPECT_TRUE(lazy_ref.gray.empty());
+  EXPECT_EQ(cv::countNonZero(lazy_ref.descriptors != ref.descriptors), 0);
+  const int cur_described = std::count(lazy_cur.described.begin(), lazy_cur.described.end(), 1);
+  EXPECT_GE(cur_described, static_cast<int>(matches.size()));
+  EXPECT_LE(cur_described, static_cast<int>(lazy_cur.segments.size() + 3) / 2);
+  // Completing the description gives the eager rows and releases the image.
+  std::vector<int> all(lazy_cur.segments.size());
+  std::iota(all.begin(), all.end(), 0);
+  lazy.Describe(all, &lazy_cur);
+  EXPECT_TRUE(lazy_cur.FullyDescribed());
+  EXPECT_TRUE(lazy_cur.gray.empty());
+  EXPECT_EQ(cv::countNonZero(lazy_cur.descriptors != cur.descriptors), 0);
 }
 
 TEST(LineMatcher, GatingRejectsFarAndOppositeCandidates) {

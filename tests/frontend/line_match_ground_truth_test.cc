@@ -103,7 +103,10 @@ Clip MakeClip(const std::string& preset, int seed) {
   synth.supersampling = 1;  // CI budget under the sanitizers (docs/reliability.md)
 #endif
   Clip clip{synthetic::MakeSequence(synth), {}, {}};
-  LineFrontend frontend{LineFrontendOptions()};
+  // Every segment described once here: the tests match copies of these frames.
+  LineFrontendOptions options;
+  options.descriptor.on_demand = false;
+  LineFrontend frontend{options};
   for (int keyframe : {0, 25}) {
     for (int gap : {0, 1, 5, 10}) {
       clip.rendered[keyframe + gap] = test::RenderFrameForTest(clip.sequence, keyframe + gap);
@@ -126,15 +129,15 @@ void ForEachMatch(const Clip& clip, bool predicted, Visit visit) {
   LineFrontend frontend{LineFrontendOptions()};
   for (int keyframe : {0, 25}) {
     for (int gap : {1, 5, 10}) {
-      const LineFrame& ref = clip.lines.at(keyframe);
-      const LineFrame& cur = clip.lines.at(keyframe + gap);
+      LineFrame ref = clip.lines.at(keyframe);
+      LineFrame cur = clip.lines.at(keyframe + gap);
       const SE3 cur_from_ref = clip.sequence.ground_truth[keyframe + gap].world_from_cam.Inverse() *
                                clip.sequence.ground_truth[keyframe].world_from_cam;
       const PinholeCamera& camera = clip.sequence.camera;
       const cv::Mat& depth = clip.rendered.at(keyframe).depth;
       const SegmentPredictor predictor =
           predicted ? PredictorFromDepth(camera, depth, cur_from_ref) : SegmentPredictor();
-      for (const LineMatch& m : frontend.Match(ref, cur, predictor)) {
+      for (const LineMatch& m : frontend.Match(&ref, &cur, predictor)) {
         const LineMatchTruth truth = JudgeLineMatchByDepth(camera, ref.segments[m.ref_index], depth,
                                                            cur_from_ref, cur.segments[m.cur_index]);
         visit(keyframe, gap, m, truth);
