@@ -145,7 +145,17 @@ void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
   const int edge = map_.edge_id(index);
   const bool has_line = options_.use_line_stereo && edge >= 0 &&
                         edge < static_cast<int>(lines_in_cur.size()) && lines_in_cur[edge].matched;
-  if (has_line) {
+  using SsdUse = MappingOptions::LineStereoSsd;
+  const bool ssd_first =
+      has_line && options_.line_stereo_ssd == SsdUse::kFirst && patch_status == StereoStatus::kOk;
+  if (ssd_first) {
+    // A failed search here does not blacklist the pixel: the line-guided match may still work.
+    ++stats->ssd_attempts;
+    status = SearchEpipolarSsd(current, geometry, patch, pixel, idepth_min, idepth_max, options_,
+                               &observation);
+    stats->ssd_ok += status == StereoStatus::kOk;
+  }
+  if (has_line && status != StereoStatus::kOk) {
     ++stats->line_attempts;
     // Without line_stereo_prior_interval only the global bounds apply to the line-guided match;
     // the fusion's outlier gate judges it against the prior.
@@ -156,13 +166,17 @@ void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
                       patch_status == StereoStatus::kOk ? &patch : nullptr, &observation);
     if (status == StereoStatus::kOk) {
       ++stats->line_ok;
-      if (options_.line_stereo_refine_ssd && patch_status == StereoStatus::kOk) {
+      if ((options_.line_stereo_ssd == SsdUse::kRefine ||
+           options_.line_stereo_ssd == SsdUse::kRefineMorePrecise) &&
+          patch_status == StereoStatus::kOk) {
         const double range = options_.search_sigmas * std::sqrt(observation.idepth_var);
         StereoObservation refined;
         if (SearchEpipolarSsd(current, geometry, patch, pixel,
                               std::max(idepth_min, observation.idepth - range),
                               std::min(idepth_max, observation.idepth + range), options_,
-                              &refined) == StereoStatus::kOk) {
+                              &refined) == StereoStatus::kOk &&
+            (options_.line_stereo_ssd == SsdUse::kRefine ||
+             refined.idepth_var < observation.idepth_var)) {
           observation = refined;
           ++stats->line_refined;
         }
@@ -176,7 +190,7 @@ void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
     }
   }
   if (status != StereoStatus::kOk) {
-    if (patch_status != StereoStatus::kOk) return;
+    if (patch_status != StereoStatus::kOk || ssd_first) return;
     ++stats->ssd_attempts;
     status = SearchEpipolarSsd(current, geometry, patch, pixel, idepth_min, idepth_max, options_,
                                &observation);

@@ -16,6 +16,7 @@ struct MappingOptions {
   enum class Init { kRandom, kConstant };
   enum class OutlierModel { kValidityCounter, kInlierRatio };
   enum class LineRegularizationMethod { kRay1d, kPaper2d };
+  enum class LineStereoSsd { kFallback, kRefine, kRefineMorePrecise, kFirst };
 
   // ---- Pixel selection.
   // A keyframe pixel gets a depth hypothesis when |grad I| (central differences, gray levels per
@@ -78,10 +79,13 @@ struct MappingOptions {
   double min_line_epipolar_angle_deg = 10.0;
   // Check the line-guided match photometrically with one 5-sample SSD (max_ssd_rms).
   bool line_stereo_check_ssd = true;
-  // Refine a line-guided match by the 5-sample SSD search restricted to the line match's
-  // idepth +- search_sigmas sigma_lambda (the line disambiguates, the SSD localises); the SSD
-  // observation replaces the line one when the search succeeds.
-  bool line_stereo_refine_ssd = false;
+  // How the 5-sample SSD search joins the line-guided stereo on a matched edge's pixel.
+  // kFallback: only where the line-guided match is ill-conditioned. kRefine: also re-search
+  // within the line match's idepth +- search_sigmas sigma_lambda (the line disambiguates, the
+  // SSD localises) and take the SSD's match when that search succeeds; kRefineMorePrecise: only
+  // when its variance is also the smaller one. kFirst: search the whole prior interval first (as
+  // for a pixel without a line); the line-guided match only where that search fails.
+  LineStereoSsd line_stereo_ssd = LineStereoSsd::kFallback;
   // Add the keyframe line's perpendicular position error at the pixel (x^T Sigma_l1 x) to the
   // current line's in eq. 10, as a part of the observation's error that every line-guided
   // observation of the pixel shares (the same keyframe detection in every frame).
@@ -209,8 +213,14 @@ struct MappingOptions {
             "Below this epipolar/edge angle use the SSD search, degrees (default 10).");
     v.Field("line_stereo_check_ssd", &line_stereo_check_ssd,
             "Check line-guided matches with one 5-sample SSD (default true).");
-    v.Field("line_stereo_refine_ssd", &line_stereo_refine_ssd,
-            "Refine line-guided matches by an SSD search within +- search_sigmas of them.");
+    v.Choice("line_stereo_ssd", &line_stereo_ssd,
+             {{"fallback", LineStereoSsd::kFallback},
+              {"refine", LineStereoSsd::kRefine},
+              {"refine_more_precise", LineStereoSsd::kRefineMorePrecise},
+              {"first", LineStereoSsd::kFirst}},
+             "SSD search on matched edges: where the line is ill-conditioned (default), also "
+             "within +- search_sigmas of the line's match (refine, refine_more_precise: if its "
+             "variance is smaller), or over the whole interval before the line (first).");
     v.Field("line_stereo_keyframe_line_var", &line_stereo_keyframe_line_var,
             "Add the keyframe line's position error to eq. 10, shared by all of the pixel's "
             "line-guided observations (default true).");
