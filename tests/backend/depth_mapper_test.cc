@@ -95,30 +95,16 @@ TEST(DepthMapperTest, LineRegularizationReducesEdgeError) {
   EXPECT_GT(r.photometric.line_stats.edges_fitted, 20);
 }
 
-TEST(DepthMapperTest, SsdRefinementRescuesLineGuidedStereoFromNoisyLines) {
-  // At 1 px endpoint noise the plain line-guided match is worse than the SSD search; refining it
-  // by the SSD search within +- 2 sigma_lambda (mapping.line_stereo_ssd=refine) keeps the line's
-  // disambiguation and the SSD's localisation. Measured (edge median relative error after the 3D
-  // line regularisation): plain 0.0371, refined 0.0111, photometric 0.0115.
-  MapEvalConfig config = SmallConfig();
-  config.line_sigma_px = 1.0;
-  config.line_sigma_sweep = {};
-  const MapEvalResult plain = Evaluate(config);
-  config.mapping.line_stereo_ssd = MappingOptions::LineStereoSsd::kRefine;
-  const MapEvalResult refined = Evaluate(config);
-  const double plain_error = plain.line_guided.edges_line_regularized.median_rel_error;
-  const double refined_error = refined.line_guided.edges_line_regularized.median_rel_error;
-  const double photometric_error = refined.photometric.edges_line_regularized.median_rel_error;
-  EXPECT_GT(refined.line_guided.line_refined, 1000);
-  EXPECT_LT(refined_error, 0.5 * plain_error);
-  EXPECT_LT(refined_error, 1.2 * photometric_error);
-}
-
-TEST(DepthMapperTest, SsdSearchModesOnMatchedEdges) {
-  // The other mapping.line_stereo_ssd modes at 1 px endpoint noise. refine_more_precise replaces
-  // the line's match only where refine would and the SSD's variance is also the smaller: fewer
-  // replacements. first searches the whole prior interval before the line: the SSD takes edge
-  // pixels the line took, and the edges get about the SSD search's accuracy.
+TEST(DepthMapperTest, SsdSearchModesOnMatchedEdgesAtOnePixelLineNoise) {
+  // mapping.line_stereo_ssd at 1 px endpoint noise, where the plain line-guided match (fallback)
+  // is worse than the SSD search. refine (the SSD search within +- 2 sigma_lambda of the line's
+  // match) keeps the line's disambiguation and the SSD's localisation; refine_more_precise
+  // replaces the line's match only where refine would and the SSD's variance is also the
+  // smaller: fewer replacements; first searches the whole prior interval before the line: the
+  // SSD takes edge pixels the line took, and the edges get about the SSD search's accuracy.
+  // Measured (edge median relative error after the 3D line regularisation): fallback 0.0371,
+  // refine 0.0111, photometric 0.0115; replacements refine 12426, refine_more_precise 11751;
+  // first: line-guided matches 18284 -> 3187, SSD matches 24096 -> 46746, edge error 0.0102.
   MapEvalConfig config = SmallConfig();
   config.line_sigma_px = 1.0;
   config.line_sigma_sweep = {};
@@ -129,16 +115,19 @@ TEST(DepthMapperTest, SsdSearchModesOnMatchedEdges) {
   const MapEvalResult more_precise = Evaluate(config);
   config.mapping.line_stereo_ssd = MappingOptions::LineStereoSsd::kFirst;
   const MapEvalResult first = Evaluate(config);
-  // Measured: replacements refine 12426, refine_more_precise 11751; first: line-guided matches
-  // 18284 -> 3187, SSD matches 24096 -> 46746, edge error 0.0102 (photometric 0.0104, fallback
-  // 0.0368).
+  auto edge_error = [](const MapEvalRun& run) {
+    return run.edges_line_regularized.median_rel_error;
+  };
+  const double photometric_error = edge_error(refine.photometric);
   EXPECT_EQ(fallback.line_guided.line_refined, 0);
+  EXPECT_GT(refine.line_guided.line_refined, 1000);
+  EXPECT_LT(edge_error(refine.line_guided), 0.5 * edge_error(fallback.line_guided));
+  EXPECT_LT(edge_error(refine.line_guided), 1.2 * photometric_error);
   EXPECT_GT(more_precise.line_guided.line_refined, 0);
   EXPECT_LT(more_precise.line_guided.line_refined, refine.line_guided.line_refined);
   EXPECT_LT(first.line_guided.line_ok, fallback.line_guided.line_ok / 2);
   EXPECT_GT(first.line_guided.ssd_ok, fallback.line_guided.ssd_ok);
-  EXPECT_LT(first.line_guided.edges_line_regularized.median_rel_error,
-            1.2 * first.photometric.edges_line_regularized.median_rel_error);
+  EXPECT_LT(edge_error(first.line_guided), 1.2 * photometric_error);
 }
 
 TEST(DepthMapperTest, NeesInSaneBand) {
