@@ -705,9 +705,19 @@ void Odometry::MapOrSwitchKeyframe(int index, double timestamp, const cv::Mat& i
   const int overlap_level = std::min(2, reference_.num_levels() - 1);
   const double overlap = ReferenceOverlap(reference_, overlap_level, cur_from_kf);
   timing.reference_ms += MsSince(start);
-  const KeyframeDecision decision =
-      DecideKeyframe(config_.keyframes, cur_from_kf, map_->mean_idepth, overlap,
-                     tracking.inlier_fraction, keyframe_.frames_tracked);
+  // The keyframe's photometric misfit in gray levels: the image noise the frame's errors imply
+  // (a whitened RMS would be relative to the previous frame's estimated sigma_I), else the RMS.
+  const double rms = tracking.intensity_noise_sigma > 0.0 ? tracking.intensity_noise_sigma
+                                                          : RetryTrigger::Rms(tracking);
+  if (rms > 0.0 && (keyframe_.min_rms == 0.0 || rms < keyframe_.min_rms)) keyframe_.min_rms = rms;
+  KeyframeEvidence evidence;
+  evidence.cur_from_kf = cur_from_kf;
+  evidence.mean_idepth = map_->mean_idepth;
+  evidence.overlap = overlap;
+  evidence.inlier_fraction = tracking.inlier_fraction;
+  evidence.rms_growth = keyframe_.min_rms > 0.0 ? rms / keyframe_.min_rms : 1.0;
+  evidence.frames_tracked = keyframe_.frames_tracked;
+  const KeyframeDecision decision = DecideKeyframe(config_.keyframes, evidence);
   if (decision.new_keyframe) {
     // The new keyframe's segments that the verified matches tie to the old keyframe's.
     std::vector<int> previous_segment(lines.segments.size(), -1);

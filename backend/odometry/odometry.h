@@ -143,6 +143,7 @@ class Odometry {
     cv::Mat image;
     LineFrame lines;
     int frames_tracked = 0;
+    double min_rms = 0.0;  // smallest photometric misfit of the frames tracked against it (0: none)
   };
 
   // Throws std::invalid_argument when `image` is not a gray image of the camera's size.

@@ -12,6 +12,9 @@ std::string KeyframeOptions::Check() const {
   if (!(min_inlier_fraction >= 0.0 && min_inlier_fraction <= 1.0)) {
     return "min_inlier_fraction must be in [0, 1]";
   }
+  if (!(max_rms_growth == 0.0 || max_rms_growth > 1.0) || !std::isfinite(max_rms_growth)) {
+    return "max_rms_growth must be 0 (off) or > 1";
+  }
   return "";
 }
 

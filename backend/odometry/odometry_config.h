@@ -50,6 +50,12 @@ struct KeyframeOptions {
   // (TrackingResult::inlier_fraction): the keyframe no longer looks like the scene (exposure
   // drift, blur) though the frame is still tracked (tracking.min_inlier_fraction); 0 = off.
   double min_inlier_fraction = 0.5;
+  // New keyframe when the frame's photometric misfit (the image noise its errors imply, gray
+  // levels) exceeds this times the smallest misfit of the frames tracked against the keyframe:
+  // the keyframe explains the image worse and worse (DSO uses 2x the first frame's RMS, Engel et
+  // al. PAMI 2018 Sec. 3.1; the smallest is robust to the first frame's fresh map); 0 = off
+  // (default).
+  double max_rms_growth = 0.0;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
@@ -65,6 +71,9 @@ struct KeyframeOptions {
     v.Field("min_inlier_fraction", &min_inlier_fraction,
             "New keyframe when fewer of the tracked frame's valid rows are inliers; 0 = off "
             "(default 0.5).");
+    v.Field("max_rms_growth", &max_rms_growth,
+            "New keyframe when the photometric misfit exceeds this times the smallest since the "
+            "keyframe; 0 = off (default 0).");
   }
   std::string Check() const;
 };

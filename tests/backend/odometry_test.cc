@@ -398,6 +398,28 @@ TEST(OdometryTest, AffineBrightnessFollowsAGlobalGainAndBias) {
   EXPECT_GT(EvaluateTrajectory(gt, plain.estimate).rpe_cm_s, 2.0 * eval.rpe_cm_s);
 }
 
+TEST(OdometryTest, RmsGrowthStartsKeyframesWhenTheKeyframeExplainsTheFrameWorse) {
+  // A global gain drifting 2% per frame without the brightness model: the photometric misfit
+  // against the keyframe grows frame by frame. With the inlier criterion off, only
+  // keyframes.max_rms_growth can react to it.
+  std::vector<FrameLighting> lighting(kFrames);
+  for (int i = 0; i < kFrames; ++i) lighting[i].gain = 1.0 + 0.02 * i;
+  OdometryConfig config = DeterministicConfig();
+  config.keyframes.min_inlier_fraction = 0.0;
+  const RunResult off = RunSequence(config, {}, kFrames, lighting);
+  config.keyframes.max_rms_growth = 1.5;
+  const RunResult on = RunSequence(config, {}, kFrames, lighting);
+  auto rms_keyframes = [](const RunResult& run) {
+    return std::count_if(run.frames.begin(), run.frames.end(), [](const OdometryFrameResult& f) {
+      return f.message == "new keyframe: rms";
+    });
+  };
+  // Measured: 3 keyframes without the criterion, 12 with it (11 of them for the RMS).
+  EXPECT_EQ(rms_keyframes(off), 0);
+  EXPECT_GE(rms_keyframes(on), 4);
+  EXPECT_GT(on.stats.keyframes, off.stats.keyframes);
+}
+
 TEST(OdometryConfigTest, UnknownKeyIsAnError) {
   OdometryConfig config;
   EXPECT_THROW(ApplyOverrides({"odometry.no_such_key=1"}, &config), std::invalid_argument);
