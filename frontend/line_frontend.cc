@@ -82,6 +82,14 @@ void LineFrontend::Describe(const std::vector<int>& indices, LineFrame* frame) {
 std::vector<LineMatch> LineFrontend::Match(LineFrame* keyframe, LineFrame* frame,
                                            const SegmentPredictor& predictor,
                                            LineFrontendTiming* timing) {
+  for (const LineFrame* lines : {keyframe, frame}) {
+    if (lines->described.size() != lines->segments.size() ||
+        lines->descriptors.rows != static_cast<int>(lines->segments.size())) {
+      throw std::invalid_argument(std::string(__FILE__) +
+                                  ": a LineFrame needs one descriptor row and one `described` "
+                                  "flag per segment (LineFrontend::Process makes them)");
+    }
+  }
   WallClock::time_point start = WallClock::now();
   const std::vector<std::vector<int>> gated =
       matcher_.Gate(keyframe->segments, frame->segments, predictor);

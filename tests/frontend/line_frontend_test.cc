@@ -211,6 +211,10 @@ TEST(LineFrontend, OnDemandDescriptionMatchesAsDescribingEverything) {
   const int cur_described = std::count(lazy_cur.described.begin(), lazy_cur.described.end(), 1);
   EXPECT_GE(cur_described, static_cast<int>(matches.size()));
   EXPECT_LE(cur_described, static_cast<int>(lazy_cur.segments.size() + 3) / 2);
+  // A hand-made frame without the flags is refused, not read out of bounds.
+  LineFrame hand_made = cur;
+  hand_made.described.clear();
+  EXPECT_THROW(lazy.Match(&lazy_ref, &hand_made), std::invalid_argument);
   // Completing the description gives the eager rows and releases the image.
   std::vector<int> all(lazy_cur.segments.size());
   std::iota(all.begin(), all.end(), 0);
