@@ -83,6 +83,7 @@ consensus_check	odometry.line_consensus_max_cost_drop=8.4	odometry.line_consensu
 estimated_noise	tracking.problem.weighting.intensity_noise=estimated	tracking.problem.weighting.intensity_noise=fixed	sigma_I of eq. 5 estimated from the previous frame's photometric errors instead of a fixed 4 gray levels: the ratio of photometric to point-to-line weights does not move with the camera's contrast (docs/tracking.md).
 alternative_poses	odometry.try_alternatives=true	odometry.try_alternatives=false	Retries lost or high-residual frames from zero motion and small rotations.
 point_budget_4000	mapping.max_reference_points=4000	mapping.max_reference_points=0	At most 4000 tracking reference points per pyramid level: bounds the tracking time.
+rms_keyframes	keyframes.max_rms_growth=1.5	keyframes.max_rms_growth=0	A new keyframe when the frame's photometric misfit exceeds 1.5x the smallest since the keyframe (DSO's criterion): a keyframe that explains the image worse and worse (exposure drift, a wrong motion) is replaced early (docs/odometry.md).
 no_line_regularisation	mapping.line_regularization=false	mapping.line_regularization=true	Leaves out the paper's 3D line regularisation (eqs. 11-13), which made points_lines worse on most of the development set (docs/mapping.md).
 TSV
 

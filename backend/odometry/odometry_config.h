@@ -54,7 +54,7 @@ struct KeyframeOptions {
   // levels) exceeds this times the smallest misfit of the frames tracked against the keyframe:
   // the keyframe explains the image worse and worse (DSO uses 2x the first frame's RMS, Engel et
   // al. PAMI 2018 Sec. 3.1; the smallest is robust to the first frame's fresh map); 0 = off
-  // (default).
+  // (OdometryConfig sets 1.5).
   double max_rms_growth = 0.0;
 
   template <class Visitor>
@@ -73,7 +73,7 @@ struct KeyframeOptions {
             "(default 0.5).");
     v.Field("max_rms_growth", &max_rms_growth,
             "New keyframe when the photometric misfit exceeds this times the smallest since the "
-            "keyframe; 0 = off (default 0).");
+            "keyframe; 0 = off (default 1.5; sdvo and paper 0).");
   }
   std::string Check() const;
 };
@@ -312,11 +312,13 @@ struct BackendOptions {
 
 struct OdometryConfig {
   // Defaults of the sub-structs, except the line detector: EDLines (at 640x480 about 4x faster
-  // than LSD; measured in docs/odometry.md), and tracking's image noise, estimated from the
-  // residuals so that the balance of eqs. 5-6 does not move with the contrast (docs/tracking.md).
+  // than LSD; measured in docs/odometry.md), tracking's image noise, estimated from the residuals
+  // so that the balance of eqs. 5-6 does not move with the contrast (docs/tracking.md), and a new
+  // keyframe when the photometric misfit grows 1.5x (docs/odometry.md, "Keyframes").
   OdometryConfig() {
     lines.detector.method = LineDetectorOptions::Method::kEdLines;
     tracking.problem.weighting.intensity_noise = IntensityNoiseSource::kEstimated;
+    keyframes.max_rms_growth = 1.5;
   }
 
   DatasetOptions dataset;

@@ -65,6 +65,7 @@ void ExpectExtras(const OdometryConfig& config, bool on, const std::string& name
   EXPECT_EQ(config.odometry.line_consensus_max_cost_drop, on ? 8.4 : 0.0);
   EXPECT_EQ(config.tracking.problem.weighting.intensity_noise,
             on ? IntensityNoiseSource::kEstimated : IntensityNoiseSource::kFixed);
+  EXPECT_EQ(config.keyframes.max_rms_growth, on ? 1.5 : 0.0);
 }
 
 // Per shipped file: what its header comment says it turns on.
@@ -114,6 +115,7 @@ const std::map<std::string, std::function<void(const OdometryConfig&)>>& Cases()
          EXPECT_FALSE(c.mapping.line_regularization);
          EXPECT_TRUE(c.odometry.two_view_bootstrap);  // the same start as points_lines
          EXPECT_EQ(c.tracking.problem.weighting.intensity_noise, IntensityNoiseSource::kFixed);
+         EXPECT_EQ(c.keyframes.max_rms_growth, 0.0);
        }},
       {"lines_only",
        [](const OdometryConfig& c) {
