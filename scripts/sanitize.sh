@@ -2,7 +2,7 @@
 # Builds the whole test suite with AddressSanitizer + UndefinedBehaviorSanitizer (LeakSanitizer
 # included) into ${PLDVO_ASAN_BUILD_DIR:-build-asan} and runs every test; any sanitizer report
 # fails its test. Usage: scripts/sanitize.sh [ctest args...]   (e.g. -R Trajectory)
-# ${PLDVO_ASAN_FLAGS:--O1 -g1} are the compile flags (.ci/run passes -O1 -g0) and
+# ${PLDVO_ASAN_FLAGS:--O1 -g1} are the compile flags (.ci/run passes -O2 -g0) and
 # ${PLDVO_ASAN_CXX:-clang++} the compiler (clang builds the suite 20-30% faster than g++, and the
 # fuzzers need it anyway; PLDVO_ASAN_CXX=g++ gives gcc's sanitizers). Prints the build
 # and test wall times. ${PLDVO_ASAN_STACK_USE_AFTER_RETURN:-1}: ASan's detect_stack_use_after_return
