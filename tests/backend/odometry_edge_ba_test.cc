@@ -39,7 +39,6 @@ constexpr int kRepeatFrames = 18;
 constexpr int kFrames = 48;
 constexpr int kRepeatFrames = kFrames;
 #endif
-constexpr int kAccuracyFrames = kFrames;
 
 using test::RenderedSequence;
 
@@ -118,8 +117,8 @@ RunResult RunSequence(const OdometryConfig& config, OdometryObserver* observer =
 TEST(OdometryEdgeBATest, AppliesResultsAndIsNotWorseThanWithout) {
   PLDVO_RELEASE_ONLY_ACCURACY_TEST("OdometryEdgeBATest.SynchronousModeRepeatsExactly");
   EdgeDepthObserver depth_without, depth_no_feedback, depth_with;
-  const RunResult without = RunSequence(Config(false), &depth_without, kAccuracyFrames);
-  const RunResult with = RunSequence(Config(true), &depth_with, kAccuracyFrames);
+  const RunResult without = RunSequence(Config(false), &depth_without, kFrames);
+  const RunResult with = RunSequence(Config(true), &depth_with, kFrames);
   EXPECT_EQ(without.stats.edge_ba_windows, 0);
   for (const OdometryFrameResult& frame : with.frames) {
     EXPECT_TRUE(IsTracked(frame.status))
@@ -138,12 +137,12 @@ TEST(OdometryEdgeBATest, AppliesResultsAndIsNotWorseThanWithout) {
   EXPECT_EQ(with.stats.edge_ba_line_depth_jobs, with.stats.edge_ba_applied);
   EXPECT_GT(with.stats.edge_ba_line_depths_fused, 0);
   const RunResult no_feedback =
-      RunSequence(Config(true, false), &depth_no_feedback, kAccuracyFrames);
+      RunSequence(Config(true, false), &depth_no_feedback, kFrames);
   EXPECT_EQ(no_feedback.stats.edge_ba_line_depth_jobs, 0);
   EXPECT_EQ(no_feedback.stats.edge_ba_line_depths_fused, 0);
   EXPECT_TRUE(no_feedback.covariance_ms.empty());
   const Trajectory& all = Sequence().sequence.ground_truth;
-  const Trajectory ground_truth(all.begin(), all.begin() + kAccuracyFrames);
+  const Trajectory ground_truth(all.begin(), all.begin() + kFrames);
   const EvaluationResult eval_without = EvaluateTrajectory(ground_truth, without.estimate);
   const EvaluationResult eval_with = EvaluateTrajectory(ground_truth, with.estimate);
   EXPECT_DOUBLE_EQ(eval_with.coverage, 1.0);
