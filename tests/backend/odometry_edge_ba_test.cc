@@ -136,8 +136,7 @@ TEST(OdometryEdgeBATest, AppliesResultsAndIsNotWorseThanWithout) {
   EXPECT_EQ(with.covariance_ms.size(), static_cast<size_t>(with.stats.edge_ba_applied));
   EXPECT_EQ(with.stats.edge_ba_line_depth_jobs, with.stats.edge_ba_applied);
   EXPECT_GT(with.stats.edge_ba_line_depths_fused, 0);
-  const RunResult no_feedback =
-      RunSequence(Config(true, false), &depth_no_feedback, kFrames);
+  const RunResult no_feedback = RunSequence(Config(true, false), &depth_no_feedback, kFrames);
   EXPECT_EQ(no_feedback.stats.edge_ba_line_depth_jobs, 0);
   EXPECT_EQ(no_feedback.stats.edge_ba_line_depths_fused, 0);
   EXPECT_TRUE(no_feedback.covariance_ms.empty());
