@@ -10,7 +10,7 @@
 # synthetic family at PLDVO_DEV_SEEDS, default "1 2 3", 640x480, and fr1/rpy and KITTI 00 when
 # present), PLDVO_DEV_FRAMES frames (default 300), PLDVO_DEV_FILTER an extended regex on the
 # sequence names. Both: PLDVO_DEV_REPEATS initial maps (default 3; mapping.init_seed 1..R),
-# inline mapping (deterministic), PLDVO_DEV_JOBS runs at a time. The full set is 38 configs x 35
+# inline mapping (deterministic), PLDVO_DEV_JOBS runs at a time. The full set is 42 configs x 35
 # sequences x R maps: a cluster job (docs/cluster.md; the grid's configs are in $dir/configs after
 # the first step).
 # Needs python3 with PyYAML (Debian: python3-yaml, which scripts/install_deps.sh installs) to
@@ -124,9 +124,13 @@ echo "deviations.sh: ${#datasets[@]} sequences x $num_configs configs x $repeats
   --out "$dir/grid" --repeats "$repeats" --jobs "$jobs" --skip_existing --run_max_frames "$frames" \
   --set odometry.parallel_mapping=false > "$dir/ablate.log" || true
 
-python3 - "$dir" "$repeats" "$description" <<'PY'
+# The command that regenerates this page, with the set's settings.
+command="PLDVO_DEV_SET=$set_name PLDVO_DEV_REPEATS=$repeats PLDVO_DEV_FRAMES=$frames"
+[ "$set_name" = full ] && command+=" PLDVO_DEV_SEEDS=\"${PLDVO_DEV_SEEDS:-1 2 3}\""
+command+=" scripts/deviations.sh"
+python3 - "$dir" "$repeats" "$description" "$command" <<'PY'
 import csv, os, re, statistics, sys
-out, repeats, description = sys.argv[1:4]
+out, repeats, description, command = sys.argv[1:5]
 rows = list(csv.DictReader(open(os.path.join(out, 'grid', 'results.csv'))))
 datasets = list(dict.fromkeys(r['dataset'] for r in rows))
 family = lambda d: re.sub(r'_s\d+$', '', d)
@@ -176,15 +180,24 @@ w('exists, and its measured effect switched on alone in paper.yaml and switched 
 w('points_lines.yaml. Equation numbers are the paper\'s (eq. 1 E(xi), eq. 2 r_i, eq. 3 g_j,')
 w('eq. 5 Sigma_f, eq. 6 Sigma_g, eqs. 8-10 line-guided stereo, eqs. 11-13 line regularisation).')
 w('')
-w('Measured on %s, %s initial maps per sequence (mapping.init_seed 1..%s), inline mapping' % (description, repeats, repeats))
+maps = ('one initial map per sequence (mapping.init_seed 1)' if repeats == '1' else
+        '%s initial maps per sequence (mapping.init_seed 1..%s)' % (repeats, repeats))
+w('Measured on %s, %s, inline mapping' % (description, maps))
 w('(deterministic). A bad run has an RPE above twice the median of paper.yaml\'s and')
 w('points_lines.yaml\'s runs on its sequence (a map converged to a wrong structure, a collapsed')
 w('scale). First table, per sequence family: median RPE (cm/s, Sim(3)-aligned, 1 s intervals) /')
 w('bad runs / lost events / median tracking-thread ms per frame (mapping inline, included);')
 w('X: failed runs.')
+if repeats == '1':
+    w('')
+    w('With one initial map a sequence\'s RPE carries the spread over maps (up to 3x on one')
+    w('sequence, docs/benchmark.md): read a row by its counts of sequences better and worse and by')
+    w('the median over sequences, not by one sequence\'s ratio.')
 w('')
-w('Regenerate: `scripts/deviations.sh` (`PLDVO_DEV_SET=full` for the development set; writes this')
-w('page; the grid\'s results.csv/.md/.json in `${PLDVO_DEV_DIR:-/tmp/pldvo_deviations}/grid`).')
+w('Regenerate: `%s` (writes this page; the grid\'s results.csv/.md/.json in' % command)
+w('`${PLDVO_DEV_DIR:-/tmp/pldvo_deviations}/grid`; %d runs per sequence and initial map: the' %
+  len(set(r['config'] for r in rows)))
+w('full set at several maps is a cluster job, docs/cluster.md).')
 w('')
 w('| family | paper.yaml | points_lines.yaml |')
 w('| --- | --- | --- |')
