@@ -73,7 +73,6 @@ residual_noise	mapping.residual_intensity_noise=true	mapping.residual_intensity_
 ambiguity_variance	mapping.ssd_ambiguity_variance=true	mapping.ssd_ambiguity_variance=false	Adds the likelihood-weighted spread of the search's other SSD minima to the variance of an ambiguous match.
 line_ssd_check	mapping.line_stereo_check_ssd=true	mapping.line_stereo_check_ssd=false	Rejects line-guided matches whose 5-sample SSD is too large (a wrong line match).
 keyframe_line_var	mapping.line_stereo_keyframe_line_var=true	mapping.line_stereo_keyframe_line_var=false	Adds the keyframe line's position error to eq. 10, shared by all of a pixel's line-guided observations.
-prior_interval	mapping.line_stereo_prior_interval=true	mapping.line_stereo_prior_interval=false	Drops a line-guided match outside idepth +- 2 sigma of the prior instead of fusing it (a wrong match would pull the estimate).
 ray_1d_regularisation	mapping.line_regularization_method=ray_1d	mapping.line_regularization_method=paper_2d	Fits the line along the pixels' rays in inverse depth with exact inverse-variance weights (no iteration) and a conservative variance (backend/mapping/line_regularizer.h).
 prior_line_gate	odometry.line_prior_gate_px=2	odometry.line_prior_gate_px=0	Unmatches lines whose edge points reproject far from them at the pose prior, before tracking (wrong matches of repetitive patterns).
 post_line_gate	odometry.line_outlier_px=2	odometry.line_outlier_px=0	The same check after tracking; lines that fail are unmatched and the frame is tracked again.
