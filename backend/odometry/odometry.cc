@@ -308,6 +308,7 @@ void Odometry::ApplyWindowedBA(const WindowedBAResult& result) {
   windowed_ba_times_ms_.push_back(1e3 * (result.build_seconds + result.solve_seconds));
   windowed_ba_points_.push_back(static_cast<double>(result.points.size()));
   windowed_ba_iterations_.push_back(result.summary.iterations);
+  windowed_ba_outlier_targets_.push_back(static_cast<double>(result.num_outlier_targets));
   // The current keyframe relative to the keyframe its map was propagated from, before the result.
   SE3 world_from_previous;
   const bool has_previous =

@@ -129,6 +129,10 @@ class Odometry {
   const std::vector<double>& WindowedBATimesMs() const { return windowed_ba_times_ms_; }
   const std::vector<double>& WindowedBAPoints() const { return windowed_ba_points_; }
   const std::vector<double>& WindowedBAIterations() const { return windowed_ba_iterations_; }
+  // Photometric targets each applied window left out as outliers.
+  const std::vector<double>& WindowedBAOutlierTargets() const {
+    return windowed_ba_outlier_targets_;
+  }
   // backend.windowed_ba: every keyframe's pose after the last applied window that held it (or as
   // tracked), oldest first; empty without the windowed BA. Complete after Finish().
   std::vector<KeyframePoseRecord> WindowedBAKeyframePoses() const;
@@ -246,6 +250,7 @@ class Odometry {
   std::unique_ptr<WindowedBundleAdjuster> windowed_ba_adjuster_;
   std::vector<double> windowed_ba_times_ms_;
   std::vector<double> windowed_ba_points_;
+  std::vector<double> windowed_ba_outlier_targets_;
   std::vector<double> windowed_ba_iterations_;
 
   bool initialized_ = false;

@@ -513,6 +513,7 @@ SequenceRunResult SequenceRunner::Run() {
     ba["ms_mean"] = Mean(odometry.WindowedBATimesMs());
     ba["points_median"] = Median(odometry.WindowedBAPoints());
     ba["iterations_median"] = Median(odometry.WindowedBAIterations());
+    ba["outlier_targets_median"] = Median(odometry.WindowedBAOutlierTargets());
     ba["idepth_jobs"] = stats.windowed_ba_idepth_jobs;
     ba["idepths_corrected"] = stats.windowed_ba_idepths_corrected;
     Trajectory keyframes_ba;

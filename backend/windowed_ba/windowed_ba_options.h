@@ -75,6 +75,12 @@ struct WindowedBAOptions {
   // Point-to-line rows (eq. 3) for selected points on edges with a line observation in another
   // window keyframe (off: photometric only).
   bool lines = true;
+  // A point's photometric target is left out when its energy (the mean squared whitened residual
+  // of its pattern at the input estimate) exceeds outlier_energy_factor^2 times the median
+  // energy of the window's targets (DSO's outlier test, Engel et al. PAMI 2018 Sec. 3.3:
+  // occlusions, a wrong depth): such rows pull the poses and their robust loss is not convex.
+  // 0 = off.
+  double outlier_energy_factor = 0.0;
   // sigma_b of the baseline prior (the scale gauge) as a fraction of the baseline. Without
   // inverse-depth priors any value > 0 gives the same optimum (the rows are scale-invariant);
   // 1e-2 keeps the system conditioned.
@@ -125,6 +131,9 @@ struct WindowedBAOptions {
             "Prior on each inverse depth: N(input, (scale^2) V), V the depth filter's variance; "
             "0 = none.");
     v.Field("lines", &lines, "Point-to-line rows for points on edges with a line observation.");
+    v.Field("outlier_energy_factor", &outlier_energy_factor,
+            "A photometric target whose energy at the input exceeds this^2 times the window's "
+            "median is left out; 0 = off (default 0).");
     v.Field("baseline_prior_sigma_ratio", &baseline_prior_sigma_ratio,
             "sigma of the scale prior as a fraction of the baseline.");
     v.Section("weighting", &weighting, "Weighting of the residual families and robust loss.");

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
@@ -41,6 +42,22 @@ class PhotometricLineWindowBuilder : public WindowedBAProblemBuilder {
   WindowedBAOptions options_;
   bool loss_in_problem_;
 };
+
+// Mean of r_k^2 over a pattern's whitened rows (no robust loss) at the given parameters.
+double MeanRowEnergy(const ImagePyramid& target_pyramid, const PinholeCamera& camera,
+                     const std::vector<HostPixel>& pattern, const std::array<double, 7>& host_pose,
+                     const std::array<double, 7>& target_pose, double idepth,
+                     const std::array<double, 2>& host_brightness,
+                     const std::array<double, 2>& target_brightness) {
+  const HostTargetPhotometricResidual residual(target_pyramid, 0, camera, pattern);
+  const double* parameters[] = {host_pose.data(), target_pose.data(), &idepth,
+                                host_brightness.data(), target_brightness.data()};
+  double rows[8];
+  if (pattern.size() > 8 || !residual.Evaluate(parameters, rows, nullptr)) return 0.0;
+  double energy = 0.0;
+  for (size_t k = 0; k < pattern.size(); ++k) energy += rows[k] * rows[k];
+  return energy / static_cast<double>(pattern.size());
+}
 
 Eigen::Vector3d Centre(const double* cam_from_world) {
   return PoseFromParameters(cam_from_world).Inverse().translation();
@@ -145,33 +162,41 @@ WindowedBAProblem PhotometricLineWindowBuilder::Build(const WindowedBAWindow& wi
     return -1;
   };
 
-  // The blocks of one point, collected before its inverse-depth block is added (a point with
-  // too few targets is left out entirely).
+  // The blocks of every point, collected before any inverse-depth block is added: the outlier
+  // threshold is a statistic of the whole window, and a point with too few targets is left out
+  // entirely.
   struct PendingPhotometric {
     int target;
     std::vector<HostPixel> pattern;
+    double energy;  // mean squared whitened row at the input (0 when not computed)
   };
   struct PendingLine {
     int target;
     Eigen::Vector3d line;
     double sqrt_info;
   };
-  std::vector<WindowedBAProblemPoint> kept_points;
+  struct PendingPoint {
+    WindowedBAProblemPoint selected;
+    std::vector<PendingPhotometric> photometric;
+    std::vector<PendingLine> lines;
+  };
+  const bool outlier_test = photometric && options_.outlier_energy_factor > 0.0;
+  std::vector<PendingPoint> pending_points;
+  pending_points.reserve(out.points.size());
+  std::vector<double> energies;
   for (const WindowedBAProblemPoint& selected : out.points) {
     const int host = selected.host;
     const WindowedBAKeyframe& host_keyframe = keyframe(host);
     const WindowedBAPoint& point = host_keyframe.points[selected.point_index];
-    std::vector<PendingPhotometric> pending_photometric;
-    std::vector<PendingLine> pending_lines;
+    PendingPoint pending_point{selected, {}, {}};
     for (int target = 0; target < n && photometric; ++target) {
       if (target == host) continue;
       const SE3 target_from_host = world_poses[target] * world_poses[host].Inverse();
-      PendingPhotometric pending{target, {}};
+      PendingPhotometric pending{target, {}, 0.0};
       for (int p = 0; p < (dso8 ? 8 : 1); ++p) {
-        Eigen::Vector2d offset = Eigen::Vector2d::Zero();
-        if (dso8) offset << kDso8Pattern[p][0], kDso8Pattern[p][1];
         HostPixel pixel;
-        pixel.pixel_in_host = point.pixel + offset;
+        pixel.pixel_in_host.x() = point.pixel.x() + (dso8 ? kDso8Pattern[p][0] : 0.0);
+        pixel.pixel_in_host.y() = point.pixel.y() + (dso8 ? kDso8Pattern[p][1] : 0.0);
         pixel.intensity_host = host_keyframe.pyramid->SampleIntensity(0, pixel.pixel_in_host.x(),
                                                                       pixel.pixel_in_host.y());
         // eq. 5 at the linearisation point; 0 where the row's reprojection is not samplable.
@@ -182,9 +207,14 @@ WindowedBAProblem PhotometricLineWindowBuilder::Build(const WindowedBAWindow& wi
       }
       // A target where part of the pattern falls outside is left out: the rows would switch
       // on and off as the estimate moves.
-      if (static_cast<int>(pending.pattern.size()) == (dso8 ? 8 : 1)) {
-        pending_photometric.push_back(std::move(pending));
+      if (static_cast<int>(pending.pattern.size()) != (dso8 ? 8 : 1)) continue;
+      if (outlier_test) {
+        pending.energy = MeanRowEnergy(*keyframe(target).pyramid, camera, pending.pattern,
+                                       out.poses[host], out.poses[target], point.idepth,
+                                       out.brightness[host], out.brightness[target]);
+        energies.push_back(pending.energy);
       }
+      pending_point.photometric.push_back(std::move(pending));
     }
     if (lines && point.edge_id >= 0) {
       for (const WindowedBALineObservation& observation : host_keyframe.line_observations) {
@@ -201,12 +231,37 @@ WindowedBAProblem PhotometricLineWindowBuilder::Build(const WindowedBAWindow& wi
             LineSqrtInfo(options_.weighting, camera, target_from_host, point.pixel, point.idepth,
                          point.idepth_var, observation.line_in_target);  // eq. 6
         if (sqrt_info > 0.0) {
-          pending_lines.push_back({target, observation.line_in_target.line, sqrt_info});
+          pending_point.lines.push_back({target, observation.line_in_target.line, sqrt_info});
         }
       }
     }
+    pending_points.push_back(std::move(pending_point));
+  }
+
+  // DSO's outlier test (Engel et al. PAMI 2018, Sec. 3.3) relative to the window: a target whose
+  // energy exceeds factor^2 times the window's median (an occlusion, a wrong depth) is left out;
+  // relative, so that it does not move with the image's contrast.
+  double energy_threshold = std::numeric_limits<double>::infinity();
+  if (outlier_test && !energies.empty()) {
+    std::nth_element(energies.begin(), energies.begin() + energies.size() / 2, energies.end());
+    energy_threshold = options_.outlier_energy_factor * options_.outlier_energy_factor *
+                       energies[energies.size() / 2];
+  }
+
+  std::vector<WindowedBAProblemPoint> kept_points;
+  for (PendingPoint& pending_point : pending_points) {
+    std::vector<PendingPhotometric>& pending_photometric = pending_point.photometric;
+    const auto outliers =
+        std::remove_if(pending_photometric.begin(), pending_photometric.end(),
+                       [&](const PendingPhotometric& p) { return p.energy > energy_threshold; });
+    out.num_outlier_targets += static_cast<int>(pending_photometric.end() - outliers);
+    pending_photometric.erase(outliers, pending_photometric.end());
+    const std::vector<PendingLine>& pending_lines = pending_point.lines;
     const int targets = static_cast<int>(pending_photometric.size() + pending_lines.size());
     if (targets < options_.min_targets) continue;
+    const WindowedBAProblemPoint& selected = pending_point.selected;
+    const int host = selected.host;
+    const WindowedBAPoint& point = keyframe(host).points[selected.point_index];
     out.idepths.push_back(point.idepth);
     double* idepth = &out.idepths.back();
     problem.AddParameterBlock(idepth, 1);
@@ -253,6 +308,9 @@ std::string WindowedBAOptions::Check() const {
   if (max_points < 1) return "max_points must be >= 1";
   if (!(min_gradient >= 0.0) || !std::isfinite(min_gradient)) return "min_gradient must be >= 0";
   if (min_targets < 1) return "min_targets must be >= 1";
+  if (!(outlier_energy_factor >= 0.0) || !std::isfinite(outlier_energy_factor)) {
+    return "outlier_energy_factor must be >= 0 and finite";
+  }
   if (!(idepth_prior_scale >= 0.0) || !std::isfinite(idepth_prior_scale)) {
     return "idepth_prior_scale must be >= 0 and finite";
   }

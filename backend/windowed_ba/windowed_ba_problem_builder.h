@@ -66,6 +66,7 @@ struct WindowedBAProblem {
   // Statistics.
   int num_candidates = 0;  // selected by SelectWindowPoints, before the min_targets check
   int num_photometric_blocks = 0;
+  int num_outlier_targets = 0;  // photometric targets left out by outlier_energy_factor
   int num_photometric_rows = 0;
   int num_line_rows = 0;
 };

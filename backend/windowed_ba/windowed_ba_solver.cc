@@ -76,6 +76,7 @@ WindowedBAResult RunWindowedBA(const WindowedBAWindow& window, const WindowedBAO
   result.build_seconds = SecondsSince(build_start);
   result.num_photometric_rows = problem.num_photometric_rows;
   result.num_line_rows = problem.num_line_rows;
+  result.num_outlier_targets = problem.num_outlier_targets;
   const auto solve_start = std::chrono::steady_clock::now();
   result.summary = SolveWindowedBAProblem(options, &problem);
   result.solve_seconds = SecondsSince(solve_start);

@@ -47,6 +47,7 @@ struct WindowedBAResult {
   std::vector<WindowedBAResultPoint> points;        // the points that entered the problem
   int num_photometric_rows = 0;
   int num_line_rows = 0;
+  int num_outlier_targets = 0;  // WindowedBAProblem::num_outlier_targets
   double build_seconds = 0.0;
   double solve_seconds = 0.0;
 };
