@@ -297,7 +297,7 @@ void AddOccluderBoxes(SceneBuilder* b, int count, const double wall_albedo[4]) {
     const double width = std::min(rng.Uniform(0.4, 0.9), 0.9 * stretch);
     const double s0 = 0.5 + slot * stretch + rng.Uniform(0.0, stretch - width);
     b->WallBox(wall, s0, s0 + width, gap, gap + depth, 0.0, height, albedo, Pattern::kPlain, 0.1,
-               "occluder");
+               kOccluderName);
   }
 }
 

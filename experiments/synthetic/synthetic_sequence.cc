@@ -147,13 +147,18 @@ int CountVisibleEdges(const Scene& scene, const PinholeCamera& camera, const SE3
   return visible_edges;
 }
 
-// Minimum z-depth over a grid of rays covering the image, including its corners. `in_view`: the
-// primitives that rays through the image can hit.
-double MinDepthOnGrid(const Scene& scene, const PinholeCamera& camera, const SE3& world_from_cam,
-                      const std::vector<int>& in_view) {
+// What a grid of rays covering the image (its corners included) hits: the minimum z-depth, and
+// how many rays end on an occluder box. `in_view`: the primitives that rays through the image
+// can hit.
+struct GridProbe {
+  double min_depth = std::numeric_limits<double>::infinity();
+  int occluder_rays = 0;
+};
+GridProbe ProbeGrid(const Scene& scene, const PinholeCamera& camera, const SE3& world_from_cam,
+                    const std::vector<int>& in_view) {
   constexpr int kCols = 24, kRows = 18;
   const Eigen::Matrix3d rotation = world_from_cam.rotation_matrix();
-  double min_depth = std::numeric_limits<double>::infinity();
+  GridProbe probe;
   for (int r = 0; r <= kRows; ++r) {
     for (int c = 0; c <= kCols; ++c) {
       const Eigen::Vector2d pixel(-0.5 + c * camera.width / static_cast<double>(kCols),
@@ -161,17 +166,22 @@ double MinDepthOnGrid(const Scene& scene, const PinholeCamera& camera, const SE3
       Scene::Hit hit;
       if (scene.IntersectSubset(world_from_cam.translation(), rotation * camera.Unproject(pixel),
                                 in_view.data(), static_cast<int>(in_view.size()), &hit)) {
-        min_depth = std::min(min_depth, hit.t);  // t is the z-depth for a z = 1 ray
+        probe.min_depth = std::min(probe.min_depth, hit.t);  // t is the z-depth for a z = 1 ray
+        probe.occluder_rays += scene.primitives()[hit.primitive].name == kOccluderName;
       }
     }
   }
-  return min_depth;
+  return probe;
 }
 
 // "" when every frame keeps clearance, min depth and sees structure; else the first failure.
 std::string CheckPath(const SyntheticSequence& sequence) {
   const SynthOptions& options = sequence.options;
   constexpr int kMinVisibleEdges = 4;
+  // A scene with occluder boxes shows them (>= 1% of the probe's 475 rays) in at least half of
+  // the frames: else its failure mode would not be in the sequence.
+  constexpr int kMinOccluderRays = 5;
+  int frames_with_occluders = 0;
   const PinholeCamera& camera = sequence.camera;
   const FrustumCuller culler(sequence.scene, camera);
   std::vector<int> in_view;
@@ -188,16 +198,22 @@ std::string CheckPath(const SyntheticSequence& sequence) {
     culler.Candidates(-0.5, -0.5, camera.width - 0.5, camera.height - 0.5,
                       world_from_cam.rotation_matrix(), world_from_cam.translation(), culler.all(),
                       &in_view);
-    const double min_depth = MinDepthOnGrid(sequence.scene, camera, world_from_cam, in_view);
-    if (min_depth < options.min_depth) {
-      failure << "min depth " << min_depth;
+    const GridProbe probe = ProbeGrid(sequence.scene, camera, world_from_cam, in_view);
+    if (probe.min_depth < options.min_depth) {
+      failure << "min depth " << probe.min_depth;
       return failure.str();
     }
+    frames_with_occluders += probe.occluder_rays >= kMinOccluderRays;
     if (CountVisibleEdges(sequence.scene, camera, world_from_cam, in_view, kMinVisibleEdges) <
         kMinVisibleEdges) {
       failure << "fewer than " << kMinVisibleEdges << " visible edges";
       return failure.str();
     }
+  }
+  const int frames = static_cast<int>(sequence.ground_truth.size());
+  if (options.occluder_boxes > 0 && 2 * frames_with_occluders < frames) {
+    return "occluder boxes in view in " + std::to_string(frames_with_occluders) + " of " +
+           std::to_string(frames) + " frames";
   }
   return "";
 }

@@ -162,6 +162,9 @@ struct RenderedFrame {
   cv::Mat depth;  // CV_32F z-depth in metres, 0 where nothing is hit
 };
 
+// Primitive::name of the boxes that SceneStyle::occluder_boxes adds.
+inline constexpr char kOccluderName[] = "occluder";
+
 // One solid or the room's interior. A box is oriented: box_from_world maps the world into the
 // box frame, where it spans [-half_size, half_size].
 struct Primitive {
@@ -178,7 +181,7 @@ struct Primitive {
                         Pattern::kNoise, Pattern::kNoise, Pattern::kNoise};
   double texture_scale = 0.1;  // metres per texture cell
   uint32_t texture_seed = 0;
-  std::string name;  // "wall", "cabinet", "table_top", ... (for docs and debugging)
+  std::string name;  // "wall", "cabinet", "table_top", kOccluderName, ...
 };
 
 // What a pixel integrates at a ray's hit: the hit point's derivatives with respect to the image
