@@ -194,6 +194,8 @@ WindowedBAProblem PhotometricLineWindowBuilder::Build(const WindowedBAWindow& wi
       const SE3 target_from_host = world_poses[target] * world_poses[host].Inverse();
       PendingPhotometric pending{target, {}, 0.0};
       for (int p = 0; p < (dso8 ? 8 : 1); ++p) {
+        // Added per coordinate: GCC 12 at -O3 read an Eigen comma-initialised offset here
+        // uninitialised (docs/windowed_ba.md, "The pattern fix").
         HostPixel pixel;
         pixel.pixel_in_host.x() = point.pixel.x() + (dso8 ? kDso8Pattern[p][0] : 0.0);
         pixel.pixel_in_host.y() = point.pixel.y() + (dso8 ? kDso8Pattern[p][1] : 0.0);
