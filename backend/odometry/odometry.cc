@@ -190,6 +190,7 @@ OdometryFrameResult Odometry::Finalize(OdometryFrameResult result) {
   result.timing.mapping_ms = mapper_->TakeRecentJobMs();
   ++stats_.frames;
   stats_.line_term_drops += result.line_term_dropped;
+  stats_.line_term_withheld += result.line_term_withheld;
   const bool tracked = IsTracked(result.status);
   if (tracked) {
     ++stats_.tracked;
@@ -541,7 +542,13 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, PreparedFrame
   result.num_reference_points = map_->num_points;
   result.mean_idepth = map_->mean_idepth;
   LineAssociation association = MatchKeyframeLines(&lines, prior_cur_from_kf, &result);
-  UpdateReference(association.lines_in_cur, &timing);
+  // A map still at its random initialisation holds depth draws, not measurements: its
+  // point-to-line rows would fit each matched edge's random parallax
+  // (odometry.lines_on_random_map).
+  result.line_term_withheld =
+      result.num_matches > 0 && map_->random_init && !config_.odometry.lines_on_random_map;
+  UpdateReference(result.line_term_withheld ? std::vector<MatchedLine>() : association.lines_in_cur,
+                  &timing);
   TrackingResult tracking =
       TrackFrame(frame.pyramid, frame.image, index, prior_cur_from_kf, &association, &result);
   // A frame whose line term the consensus check dropped keeps a photometric-only solve, not the
@@ -620,16 +627,17 @@ TrackingResult Odometry::TrackFrame(const ImagePyramid& pyramid, const cv::Mat& 
                                     OdometryFrameResult* result) {
   const auto start = WallClock::now();
   const SE3 last_good_cur_from_kf = world_from_last_good_.Inverse() * keyframe_.world_from_kf;
+  const bool line_term = result->num_matches > 0 && !result->line_term_withheld;
   // Gate the matches around their prediction by the prior, track, then drop the matches that
   // disagree with the tracked pose and track again from it.
-  if (config_.odometry.line_prior_gate_px > 0.0 && result->num_matches > 0) {
+  if (config_.odometry.line_prior_gate_px > 0.0 && line_term) {
     result->num_line_outliers =
         RemoveLineOutliers(prior_cur_from_kf, config_.odometry.line_prior_gate_px, &reference_,
                            &association->lines_in_cur);
   }
   TrackingResult tracking = TrackWithAlternatives(
       pyramid, image, index, prior_cur_from_kf, last_good_cur_from_kf, &result->alternatives_tried);
-  if (config_.odometry.line_outlier_px > 0.0 && result->num_matches > 0 &&
+  if (config_.odometry.line_outlier_px > 0.0 && line_term &&
       tracking.status != TrackingStatus::kLost) {
     const int outliers = RemoveLineOutliers(tracking.cur_from_ref, config_.odometry.line_outlier_px,
                                             &reference_, &association->lines_in_cur);
@@ -642,8 +650,7 @@ TrackingResult Odometry::TrackFrame(const ImagePyramid& pyramid, const cv::Mat& 
       if (again.status != TrackingStatus::kLost) tracking = std::move(again);
     }
   }
-  if (consensus_ != nullptr && result->num_matches > 0 &&
-      tracking.status != TrackingStatus::kLost) {
+  if (consensus_ != nullptr && line_term && tracking.status != TrackingStatus::kLost) {
     const auto consensus_start = WallClock::now();
     std::optional<TrackingResult> photometric = consensus_->Check(reference_, pyramid, tracking);
     result->timing.consensus_ms = MsSince(consensus_start);

@@ -231,6 +231,7 @@ TrackingResult Tracker::TrackLevels(const TrackingReference& reference, const Im
     LevelResult level_result;
     level_result.level = level;
     level_result.residual_rows = built.photometric_residuals + built.line_residuals;
+    level_result.line_rows = built.line_residuals;
 
     SolverIterationCallback solver_callback;
     if (callback) {

@@ -96,6 +96,7 @@ struct LevelResult {
   int level = 0;
   int iterations = 0;
   int residual_rows = 0;  // added by the builder
+  int line_rows = 0;      // of them, point-to-line rows
   int valid_rows = 0;     // valid at the level's final pose
   int inlier_rows = 0;    // valid with |r~| <= inlier_threshold
   int photometric_valid_rows = 0;
