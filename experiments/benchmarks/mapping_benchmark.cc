@@ -5,12 +5,22 @@
 //   Mapping/regularized/...  RegularizedMap: smoothing (smooth:1) and 3D line regularisation
 //                            (lines:1), what every job publishes
 //   Mapping/reference        BuildReferencePoints of the published map (4000 points per level)
+// and the regularisation steps (backend/mapping/depth_regularizer.h) on a generated 640x480
+// semi-dense map (MakeEdgeMap: ~12% valid pixels in 3-px bands along random segments, variances
+// log-uniform over four orders of magnitude, depth discontinuities where segments cross):
+//   Mapping/smooth           SmoothDepthMap, what RegularizedMap(true, ...) runs
+//   Mapping/remove_isolated  RemoveIsolatedHypotheses  } both after every UpdateWithFrame
+//   Mapping/fill_holes       FillHoles                 }
 // Run: build/experiments/benchmarks/mapping_benchmark [--benchmark_filter=...]
 #include <benchmark/benchmark.h>
 
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <random>
 #include <vector>
 
 #include "backend/mapping/depth_mapper.h"
+#include "backend/mapping/depth_regularizer.h"
 #include "backend/odometry/reference_builder.h"
 #include "experiments/evaluation/mapping_ground_truth.h"
 #include "experiments/evaluation/synthetic_pairs.h"
@@ -103,6 +113,85 @@ void BM_Reference(benchmark::State& state) {
   state.counters["points_level0"] = reference.levels[0].points.size();
 }
 
+// The generated map of the regularisation benchmarks: 65 random segments of 40-300 px drawn
+// 3 px wide (a later segment overwrites an earlier one where they cross); each band pixel at
+// least 4 px from the border is a candidate, 90% of them valid with a per-segment plane of
+// inverse depth plus noise and a variance log-uniform in [1e-5, 1e-1] (1/m)^2, 3% of the others
+// blacklisted.
+SemiDenseDepthMap MakeEdgeMap(const MappingOptions& options) {
+  constexpr int kWidth = 640, kHeight = 480, kSegments = 65, kBorder = 4;
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  cv::Mat edge_id(kHeight, kWidth, CV_32S, cv::Scalar(-1));
+  for (int s = 0; s < kSegments; ++s) {
+    const cv::Point a(static_cast<int>(unit(rng) * kWidth), static_cast<int>(unit(rng) * kHeight));
+    const double angle = 2.0 * M_PI * unit(rng), length = 40.0 + 260.0 * unit(rng);
+    const cv::Point b(a.x + static_cast<int>(length * std::cos(angle)),
+                      a.y + static_cast<int>(length * std::sin(angle)));
+    cv::line(edge_id, a, b, cv::Scalar(s), 3, cv::LINE_8);
+  }
+  std::vector<double> base(kSegments), slope_x(kSegments), slope_y(kSegments);
+  for (int s = 0; s < kSegments; ++s) {
+    base[s] = 0.1 + 1.9 * unit(rng);
+    slope_x[s] = 1e-3 * (unit(rng) - 0.5);
+    slope_y[s] = 1e-3 * (unit(rng) - 0.5);
+  }
+  std::normal_distribution<double> noise(0.0, 0.01);
+  SemiDenseDepthMap map(kWidth, kHeight);
+  for (int y = kBorder; y < kHeight - kBorder; ++y) {
+    for (int x = kBorder; x < kWidth - kBorder; ++x) {
+      const int s = edge_id.at<int>(y, x);
+      if (s < 0) continue;
+      const int i = map.Index(x, y);
+      map.SetCandidate(i, true, s);
+      if (unit(rng) < 0.9) {
+        const double idepth = base[s] + slope_x[s] * x + slope_y[s] * y + noise(rng);
+        map.Set(i, idepth, std::pow(10.0, -5.0 + 4.0 * unit(rng)), options.validity_initial);
+      } else if (unit(rng) < 0.03) {
+        for (int k = 0; k < options.blacklist_threshold; ++k) map.AddBlacklist(i);
+      }
+    }
+  }
+  return map;
+}
+
+const SemiDenseDepthMap& GetEdgeMap() {
+  static const SemiDenseDepthMap* map = new SemiDenseDepthMap(MakeEdgeMap(MappingOptions()));
+  return *map;
+}
+
+void BM_Smooth(benchmark::State& state) {
+  const SemiDenseDepthMap& map = GetEdgeMap();
+  const MappingOptions options;
+  SemiDenseDepthMap out;
+  int smoothed = 0;
+  for (auto _ : state) {
+    smoothed = SmoothDepthMap(map, options, &out);
+    benchmark::DoNotOptimize(out);
+  }
+  state.counters["valid"] = map.CountValid();
+  state.counters["smoothed"] = smoothed;
+}
+
+// The in-place steps run on a copy of the map, assigned before every call (not timed) into the
+// same object so that its buffers keep their capacity.
+template <int (*kStep)(const MappingOptions&, SemiDenseDepthMap*)>
+void BM_InPlaceStep(benchmark::State& state) {
+  const SemiDenseDepthMap& map = GetEdgeMap();
+  const MappingOptions options;
+  SemiDenseDepthMap work = map;
+  int changed = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    work = map;
+    state.ResumeTiming();
+    changed = kStep(options, &work);
+    benchmark::DoNotOptimize(work);
+  }
+  state.counters["valid"] = map.CountValid();
+  state.counters["changed"] = changed;
+}
+
 BENCHMARK(BM_Update)->Name("Mapping/update")->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Regularized)
     ->Name("Mapping/regularized")
@@ -114,6 +203,15 @@ BENCHMARK(BM_Regularized)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_Reference)->Name("Mapping/reference")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Smooth)->Name("Mapping/smooth")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_InPlaceStep<RemoveIsolatedHypotheses>)
+    ->Name("Mapping/remove_isolated")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_InPlaceStep<FillHoles>)
+    ->Name("Mapping/fill_holes")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace pldvo

@@ -1,5 +1,5 @@
 // The semi-dense depth map's EKF update and bookkeeping, the epipolar geometry and the SSD search
-// of backend/mapping/epipolar_stereo.h, propagation and the output helpers.
+// of backend/mapping/epipolar_stereo.h, propagation, regularisation and the output helpers.
 #include "backend/mapping/semi_dense_depth_map.h"
 
 #include <gtest/gtest.h>
@@ -13,10 +13,12 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "backend/mapping/depth_map_io.h"
 #include "backend/mapping/depth_propagation.h"
+#include "backend/mapping/depth_regularizer.h"
 #include "backend/mapping/epipolar_stereo.h"
 #include "tests/random_texture.h"
 
@@ -689,6 +691,115 @@ TEST(DepthPropagationTest, IntensityCheckUndoesTheNewKeyframesBrightness) {
   EXPECT_EQ(transferred.dropped_intensity, 0);
   EXPECT_EQ(transferred.propagated,
             hypotheses - transferred.dropped_outside - transferred.dropped_not_candidate);
+}
+
+// SmoothDepthMap as it was first written (the (2r+1)^2 window of every valid pixel through the
+// accessors, two divisions per neighbour visit): the reference the optimised one must reproduce
+// bit for bit.
+int ReferenceSmoothDepthMap(const SemiDenseDepthMap& in, const MappingOptions& options,
+                            SemiDenseDepthMap* out) {
+  *out = in;
+  const int r = options.regularization_radius;
+  const double gate_sq = options.regularization_gate_sigmas * options.regularization_gate_sigmas;
+  int smoothed = 0;
+  for (int y = 0; y < in.height(); ++y) {
+    for (int x = 0; x < in.width(); ++x) {
+      const int i = in.Index(x, y);
+      if (!in.valid(i)) continue;
+      const double d_i = in.idepth(i), v_i = in.idepth_var(i);
+      double sum = d_i / v_i, sum_info = 1.0 / v_i;
+      int neighbours = 0;
+      for (int dy = -r; dy <= r; ++dy) {
+        const int yy = y + dy;
+        if (yy < 0 || yy >= in.height()) continue;
+        for (int dx = -r; dx <= r; ++dx) {
+          const int xx = x + dx;
+          if ((dx == 0 && dy == 0) || xx < 0 || xx >= in.width()) continue;
+          const int j = in.Index(xx, yy);
+          if (!in.valid(j)) continue;
+          const double d_j = in.idepth(j), v_j = in.idepth_var(j);
+          if ((d_i - d_j) * (d_i - d_j) > gate_sq * (v_i + v_j)) continue;
+          sum += d_j / v_j;
+          sum_info += 1.0 / v_j;
+          ++neighbours;
+        }
+      }
+      if (neighbours > 0) {
+        out->SetIdepth(i, sum / sum_info);
+        ++smoothed;
+      }
+    }
+  }
+  return smoothed;
+}
+
+// A random map: 40% of the pixels valid, the four corners included, on two depth layers 1 apart
+// with noise of sd 0.05 and variances log-uniform in [1e-4, 1e-1], so that the gate both admits
+// and rejects neighbours; the other pixels hold invalidated hypotheses of the same kind.
+SemiDenseDepthMap RandomSparseMap(int width, int height, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  SemiDenseDepthMap map(width, height);
+  for (int i = 0; i < map.num_pixels(); ++i) {
+    const int x = i % width, y = i / width;
+    const bool corner = (x == 0 || x == width - 1) && (y == 0 || y == height - 1);
+    const double idepth = (unit(rng) < 0.5 ? 0.5 : 1.5) + noise(rng);
+    map.Set(i, idepth, std::pow(10.0, -4.0 + 3.0 * unit(rng)), 1);
+    if (!corner && unit(rng) >= 0.4) map.Invalidate(i);
+  }
+  return map;
+}
+
+// Every pixel's validity, inverse depth and variance are identical (exact float comparison).
+void ExpectIdenticalMaps(const SemiDenseDepthMap& actual, const SemiDenseDepthMap& expected) {
+  ASSERT_EQ(actual.width(), expected.width());
+  ASSERT_EQ(actual.height(), expected.height());
+  for (int i = 0; i < actual.num_pixels(); ++i) {
+    ASSERT_EQ(actual.valid(i), expected.valid(i)) << "pixel " << i;
+    ASSERT_EQ(actual.idepth(i), expected.idepth(i)) << "pixel " << i;
+    ASSERT_EQ(actual.idepth_var(i), expected.idepth_var(i)) << "pixel " << i;
+  }
+}
+
+int CountDifferentIdepths(const SemiDenseDepthMap& a, const SemiDenseDepthMap& b) {
+  int different = 0;
+  for (int i = 0; i < a.num_pixels(); ++i) different += a.idepth(i) != b.idepth(i);
+  return different;
+}
+
+TEST(DepthRegularizerTest, MatchesTheReferenceBitForBit) {
+  // 41x29 with windows of radius 1-3, and 3x2, smaller than every window.
+  const std::vector<std::pair<int, int>> sizes = {{41, 29}, {3, 2}};
+  for (const auto& [width, height] : sizes) {
+    for (int radius = 1; radius <= 3; ++radius) {
+      for (const double gate_sigmas : {1.0, 2.0}) {
+        SCOPED_TRACE(testing::Message()
+                     << width << "x" << height << " r " << radius << " gate " << gate_sigmas);
+        MappingOptions options;
+        options.regularization_radius = radius;
+        options.regularization_gate_sigmas = gate_sigmas;
+        const SemiDenseDepthMap map =
+            RandomSparseMap(width, height, 7 * radius + static_cast<int>(gate_sigmas));
+
+        SemiDenseDepthMap smoothed, expected_smoothed;
+        EXPECT_EQ(SmoothDepthMap(map, options, &smoothed),
+                  ReferenceSmoothDepthMap(map, options, &expected_smoothed));
+        ExpectIdenticalMaps(smoothed, expected_smoothed);
+
+        if (width < 10) continue;
+        // The map exercises what the comparison must catch: smoothing changes most hypotheses
+        // and the gate changes many results (dropping it would fail above).
+        MappingOptions ungated = options;
+        ungated.regularization_gate_sigmas = 1e6;
+        SemiDenseDepthMap smoothed_ungated;
+        ReferenceSmoothDepthMap(map, ungated, &smoothed_ungated);
+        EXPECT_GT(CountDifferentIdepths(expected_smoothed, map), map.CountValid() / 2);
+        EXPECT_GT(CountDifferentIdepths(expected_smoothed, smoothed_ungated),
+                  map.CountValid() / 10);
+      }
+    }
+  }
 }
 
 TEST(DepthMapIoTest, WritesPngAndPly) {
