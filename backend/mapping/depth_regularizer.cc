@@ -26,8 +26,8 @@ class ValidRows {
       row_begin_.push_back(static_cast<int>(hypotheses_.size()));
       for (int x = 0, i = map.Index(0, y); x < map.width(); ++x, ++i) {
         if (!map.valid(i)) continue;
-        const double d = map.idepth(i), v = map.idepth_var(i);
-        hypotheses_.push_back({x, map.idepth(i), map.idepth_var(i), 1.0 / v, d / v});
+        const float d = map.idepth(i), v = map.idepth_var(i);
+        hypotheses_.push_back({x, d, v, 1.0 / v, static_cast<double>(d) / v});
       }
     }
     row_begin_.push_back(static_cast<int>(hypotheses_.size()));

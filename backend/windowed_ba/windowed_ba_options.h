@@ -43,9 +43,8 @@ struct WindowedBAOptions {
   // loss row-wise inside the cost functions) or "windowed_ba_ceres_loss" (the loss given to the
   // problem per residual block, i.e. per point pattern and target).
   std::string problem_builder = "windowed_ba";
-  // The newest `window` keyframes of a window are optimised (>= 2). 7: on the development set
-  // (3 maps, 24 sequences) the frames re-anchored to the keyframes gained 0.75x against 0.80x
-  // with 5, at 1.3x the time per window (docs/windowed_ba.md).
+  // The newest `window` keyframes of a window are optimised (>= 2). 7: the best of 5 and 7 on the
+  // development set, measured in docs/windowed_ba.md.
   int window = 7;
   // Points per window (DSO: ~2000), split evenly over the keyframes; each keyframe's share is
   // chosen by SelectWindowPoints (a grid of cells, best gradient per cell).
