@@ -184,9 +184,11 @@ void MappingWorker::Run(const MappingJob& job) {
         if (!job.depth.empty()) {
           mapper_.InitializeKeyframeFromDepth(job.image, job.edges, job.depth,
                                               job.depth_idepth_var);
+          updates_since_random_init_ = -1;
         } else {
           mapper_.InitializeKeyframe(job.image, job.edges);
           published->random_init = true;
+          updates_since_random_init_ = 0;
         }
         keyframe_levels_ = ImagePyramid(job.image, job.num_levels);
         keyframe_id_ = job.keyframe_id;
@@ -197,6 +199,7 @@ void MappingWorker::Run(const MappingJob& job) {
         mapper_.UpdateWithFrame(InReferenceBrightness(job.image, job.brightness), job.cur_from_kf,
                                 job.lines_in_cur, job.pose_covariance);
         ++num_updates_;
+        if (updates_since_random_init_ >= 0) ++updates_since_random_init_;
         break;
       case MappingJob::Kind::kLineDepths:
       case MappingJob::Kind::kIdepthCorrections: {
@@ -235,6 +238,7 @@ void MappingWorker::Run(const MappingJob& job) {
         if (mapper_.depth_map().CountValid() < job.min_propagated_points) {
           mapper_.InitializeKeyframe(job.image, job.edges);
           published->random_init = true;
+          updates_since_random_init_ = 0;
         }
         keyframe_levels_ = ImagePyramid(job.image, job.num_levels);
         keyframe_id_ = job.keyframe_id;
@@ -244,6 +248,7 @@ void MappingWorker::Run(const MappingJob& job) {
     }
     published->keyframe_id = keyframe_id_;
     published->num_updates = num_updates_;
+    published->updates_since_random_init = updates_since_random_init_;
     published->map = std::make_shared<const SemiDenseDepthMap>(
         mapper_.RegularizedMap(options_.regularize, options_.line_regularization));
     Publish(std::move(published));

@@ -46,6 +46,9 @@ struct KeyframeMap {
   int retired_keyframe_id = -1;
   PropagationStats propagation;  // of the switch that created this keyframe
   bool random_init = false;      // the map was (re)initialised at random
+  // Stereo updates fused since the map's last random (re)initialisation, across the keyframe
+  // switches that propagated it; -1 when it descends from a measured start (depth image).
+  int updates_since_random_init = -1;
 };
 
 struct MappingJob {
@@ -140,6 +143,7 @@ class MappingWorker {
   ImagePyramid keyframe_levels_;      // the keyframe's pyramid for the reference intensities
   int keyframe_id_ = -1;
   int num_updates_ = 0;
+  int updates_since_random_init_ = -1;  // KeyframeMap::updates_since_random_init
 
   mutable std::mutex mutex_;
   std::condition_variable job_ready_;

@@ -542,11 +542,12 @@ OdometryFrameResult Odometry::Process(int index, double timestamp, PreparedFrame
   result.num_reference_points = map_->num_points;
   result.mean_idepth = map_->mean_idepth;
   LineAssociation association = MatchKeyframeLines(&lines, prior_cur_from_kf, &result);
-  // A map still at its random initialisation holds depth draws, not measurements: its
-  // point-to-line rows would fit each matched edge's random parallax
-  // (odometry.lines_on_random_map).
+  // A map in its first stereo updates after a random initialisation holds mostly depth draws,
+  // not measurements: its point-to-line rows would fit each matched edge's random parallax
+  // (odometry.random_map_warmup_updates).
   result.line_term_withheld =
-      result.num_matches > 0 && map_->random_init && !config_.odometry.lines_on_random_map;
+      result.num_matches > 0 && map_->updates_since_random_init >= 0 &&
+      map_->updates_since_random_init < config_.odometry.random_map_warmup_updates;
   UpdateReference(result.line_term_withheld ? std::vector<MatchedLine>() : association.lines_in_cur,
                   &timing);
   TrackingResult tracking =

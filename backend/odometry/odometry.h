@@ -82,7 +82,7 @@ struct OdometryStatistics {
   int edge_ba_line_depths_fused = 0;
   int edge_ba_line_depth_outliers = 0;
   int line_term_drops = 0;     // frames whose line term the consensus check dropped
-  int line_term_withheld = 0;  // frames tracked without it on a random map (lines_on_random_map)
+  int line_term_withheld = 0;  // frames tracked without it (random_map_warmup_updates)
   // backend.windowed_ba: windows solved, applied (moved the keyframe poses), solves that threw,
   // depth-correction jobs sent to the mapping thread and the hypotheses they shifted.
   int windowed_ba_windows = 0;

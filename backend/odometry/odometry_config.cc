@@ -25,6 +25,7 @@ std::string OdometryOptions::Check() const {
     return "line_consensus_max_cost_drop must be >= 0 and finite";
   }
   if (!(line_prior_gate_px >= 0.0)) return "line_prior_gate_px must be >= 0";
+  if (random_map_warmup_updates < 0) return "random_map_warmup_updates must be >= 0";
   if (!(retry_rms_ratio >= 1.0)) return "retry_rms_ratio must be >= 1";
   if (!(alternative_rotation_deg > 0.0 && alternative_rotation_deg < 45.0)) {
     return "alternative_rotation_deg must be in (0, 45)";

@@ -108,12 +108,14 @@ struct OdometryOptions {
   // texture-less direction) costs it nothing, so lines keep constraining it there.
   // chi^2_6 at 99% is 16.8, i.e. 8.4 in cost; 0 = off (the paper).
   double line_consensus_max_cost_drop = 8.4;
-  // The point-to-line term on a keyframe map that is still its random initialisation (Engel 2013
-  // Sec. 2.1: random inverse depth, large variance), i.e. before its first stereo update; false
-  // tracks such frames photometric only. The map's depths are draws, not measurements: the line
-  // rows can turn their random parallax into a pose error that the following stereo updates
-  // build into the map (docs/bootstrap.md).
-  bool lines_on_random_map = false;
+  // Stereo updates a randomly (re)initialised keyframe map (Engel 2013 Sec. 2.1: random inverse
+  // depth, large variance) must have fused before tracking uses the point-to-line term; until
+  // then frames are tracked photometric only. The first updates' depths are still mostly the
+  // draws: the line rows can turn their random parallax into a pose error that the following
+  // stereo updates build into the map (docs/bootstrap.md). Counted across keyframe switches that
+  // propagate the map; maps from the two-view bootstrap or a depth image are exempt.
+  // 0 = the line term from the first frame (the paper).
+  int random_map_warmup_updates = 3;
   // Alternative initial guesses (besides the constant-velocity prior) are tried when the result
   // is lost, or when its final photometric RMS exceeds retry_rms_ratio times the running mean
   // over recent tracked frames (backend/odometry/retry_trigger.h): zero motion since the last good
@@ -202,9 +204,10 @@ struct OdometryOptions {
     v.Field("line_consensus_max_cost_drop", &line_consensus_max_cost_drop,
             "Drop a frame's line term when a photometric-only solve from its result lowers the "
             "photometric cost by more than this (0.5 sum r^2; 0 = off).");
-    v.Field("lines_on_random_map", &lines_on_random_map,
-            "Use the point-to-line term on frames tracked against a map that is still its random "
-            "initialisation (true, the paper); false tracks them photometric only (default).");
+    v.Field("random_map_warmup_updates", &random_map_warmup_updates,
+            "Stereo updates a random initial map fuses before tracking uses the point-to-line "
+            "term; earlier frames are tracked photometric only (0 = from the start, the paper; "
+            "default 3).");
     v.Field("line_prior_gate_px", &line_prior_gate_px,
             "Unmatch lines whose edge points reproject at a median distance above this (px) at "
             "the pose prior, before tracking; 0 = off (default 2).");

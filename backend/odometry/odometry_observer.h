@@ -64,8 +64,9 @@ struct OdometryFrameResult {
   // odometry.line_consensus_max_cost_drop: the line term disagreed with the photometric one and
   // the frame keeps the photometric-only pose.
   bool line_term_dropped = false;
-  // odometry.lines_on_random_map false: the keyframe map was still its random initialisation and
-  // the frame was tracked without the point-to-line term (its matches still feed the mapping).
+  // odometry.random_map_warmup_updates: the keyframe map had fused fewer stereo updates since its
+  // random initialisation, and the frame was tracked without the point-to-line term (its matches
+  // still feed the mapping).
   bool line_term_withheld = false;
   int num_line_outliers = 0;  // matches unmatched by the verification (prior gate + after tracking)
   int num_reference_points = 0;  // level-0 points of the keyframe map

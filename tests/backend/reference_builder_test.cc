@@ -250,5 +250,43 @@ TEST(MappingWorkerTest, InlineLagHoldsUpdatesBackUntilTheNextKeyframe) {
   EXPECT_EQ(worker.Latest()->num_updates, 1);
 }
 
+TEST(MappingWorkerTest, CountsTheUpdatesSinceTheLastRandomInitialisation) {
+  // KeyframeMap::updates_since_random_init (odometry.random_map_warmup_updates): 0 on a random
+  // map, +1 per fused update, carried across a switch that propagates the map, 0 again when the
+  // switch re-initialises at random, -1 on a map from a depth image.
+  MappingOptions options;
+  MappingWorker worker(Camera(), options, /*parallel=*/false, /*max_pending_updates=*/2);
+  const cv::Mat image = Texture();
+  worker.Submit(KeyframeJob(MappingJob::Kind::kInitialize, 0, 0, image));
+  EXPECT_EQ(worker.Latest()->updates_since_random_init, 0);
+  EXPECT_TRUE(worker.Latest()->random_init);
+  for (int i = 1; i <= 2; ++i) {
+    worker.Submit(UpdateJob(0, i, image));
+    EXPECT_EQ(worker.Latest()->updates_since_random_init, i);
+  }
+  MappingJob propagate = KeyframeJob(MappingJob::Kind::kNewKeyframe, 1, 3, image);
+  propagate.new_from_old = SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(-0.02, 0.0, 0.0));
+  worker.Submit(std::move(propagate));
+  ASSERT_EQ(worker.Latest()->keyframe_id, 1);
+  EXPECT_FALSE(worker.Latest()->random_init);
+  EXPECT_EQ(worker.Latest()->updates_since_random_init, 2);
+  worker.Submit(UpdateJob(1, 4, image));
+  EXPECT_EQ(worker.Latest()->updates_since_random_init, 3);
+  MappingJob reinit = KeyframeJob(MappingJob::Kind::kNewKeyframe, 2, 5, image);
+  reinit.min_propagated_points = image.rows * image.cols + 1;  // never kept: random map
+  worker.Submit(std::move(reinit));
+  ASSERT_EQ(worker.Latest()->keyframe_id, 2);
+  EXPECT_TRUE(worker.Latest()->random_init);
+  EXPECT_EQ(worker.Latest()->updates_since_random_init, 0);
+  MappingJob from_depth = KeyframeJob(MappingJob::Kind::kInitialize, 3, 6, image);
+  from_depth.depth = cv::Mat(image.size(), CV_32F, cv::Scalar(1.0f));
+  from_depth.depth_idepth_var = 1e-4;
+  worker.Submit(std::move(from_depth));
+  worker.Submit(UpdateJob(3, 7, image));
+  ASSERT_EQ(worker.Latest()->keyframe_id, 3);
+  EXPECT_EQ(worker.Latest()->updates_since_random_init, -1);
+  EXPECT_EQ(worker.failed_jobs(), 0);
+}
+
 }  // namespace
 }  // namespace pldvo

@@ -64,7 +64,7 @@ void ExpectExtras(const OdometryConfig& config, bool on, const std::string& name
   EXPECT_EQ(config.odometry.try_alternatives, on);
   EXPECT_EQ(config.odometry.two_view_bootstrap, on);
   EXPECT_EQ(config.odometry.line_consensus_max_cost_drop, on ? 8.4 : 0.0);
-  EXPECT_EQ(config.odometry.lines_on_random_map, !on);
+  EXPECT_EQ(config.odometry.random_map_warmup_updates, on ? 3 : 0);
   EXPECT_EQ(config.tracking.problem.weighting.intensity_noise,
             on ? IntensityNoiseSource::kEstimated : IntensityNoiseSource::kFixed);
   EXPECT_EQ(config.keyframes.max_rms_growth, on ? 1.5 : 0.0);
