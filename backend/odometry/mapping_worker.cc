@@ -175,6 +175,12 @@ void MappingWorker::Publish(std::shared_ptr<KeyframeMap> keyframe_map) {
   latest_ = std::move(keyframe_map);
 }
 
+void MappingWorker::InitializeRandomMap(const MappingJob& job, KeyframeMap* published) {
+  mapper_.InitializeKeyframe(job.image, job.edges);
+  published->random_init = true;
+  updates_since_random_init_ = 0;
+}
+
 void MappingWorker::Run(const MappingJob& job) {
   const auto start = WallClock::now();
   try {
@@ -186,9 +192,7 @@ void MappingWorker::Run(const MappingJob& job) {
                                               job.depth_idepth_var);
           updates_since_random_init_ = -1;
         } else {
-          mapper_.InitializeKeyframe(job.image, job.edges);
-          published->random_init = true;
-          updates_since_random_init_ = 0;
+          InitializeRandomMap(job, published.get());
         }
         keyframe_levels_ = ImagePyramid(job.image, job.num_levels);
         keyframe_id_ = job.keyframe_id;
@@ -236,9 +240,7 @@ void MappingWorker::Run(const MappingJob& job) {
         published->propagation =
             mapper_.PropagateToNewKeyframe(job.image, job.edges, job.new_from_old, job.brightness);
         if (mapper_.depth_map().CountValid() < job.min_propagated_points) {
-          mapper_.InitializeKeyframe(job.image, job.edges);
-          published->random_init = true;
-          updates_since_random_init_ = 0;
+          InitializeRandomMap(job, published.get());
         }
         keyframe_levels_ = ImagePyramid(job.image, job.num_levels);
         keyframe_id_ = job.keyframe_id;

@@ -128,6 +128,8 @@ class MappingWorker {
 
  private:
   void Run(const MappingJob& job);
+  // The job's keyframe with the random initial map (options.init); restarts the update count.
+  void InitializeRandomMap(const MappingJob& job, KeyframeMap* published);
   void RunOldestHeldBack();
   void Publish(std::shared_ptr<KeyframeMap> keyframe_map);
   void ThreadLoop();
