@@ -15,13 +15,13 @@
 #                        '^(lowtex|boxes)_s1$'); default all
 #   PLDVO_BENCH_JOBS     runs in parallel (default 2)
 #   PLDVO_BENCH_SET      extra `--set key=value` arguments for every run (default none; e.g.
-#                        '--set odometry.inline_mapping_lag=3', the mapping thread's schedule)
+#                        '--set odometry.mapping_lag=1', the map one frame update behind)
 #   PLDVO_TUM_RPY, PLDVO_KITTI  the real sequences (default ../shared/data/tum_fr1_rpy and
 #                        ../shared/data/kitti00_first200 relative to the repository; skipped with
 #                        a message when absent)
 # Sequences (scripts/dev_set.sh) are rendered into OUT/seq_f<frames>/ and kept; runs already in OUT are kept (pldvo
 # ablate --skip_existing), so an interrupted benchmark resumes. The runs map inline
-# (odometry.parallel_mapping=false): the spread is the initial map's, not the thread timing's.
+# (odometry.parallel_mapping=false; the same results as the mapping thread, odometry.mapping_lag).
 # The full set (11 families x 3 seeds + 2 real, x 2 configs x 8 maps, 300 frames) is about 560
 # runs: hours on 2 cores.
 set -euo pipefail

@@ -13,14 +13,13 @@
 namespace pldvo {
 
 MappingWorker::MappingWorker(const PinholeCamera& camera, const MappingOptions& options,
-                             bool parallel, int max_pending_updates, bool wait_when_behind,
-                             int inline_lag)
+                             bool parallel, int max_pending_updates, bool wait_when_behind, int lag)
     : camera_(camera),
       options_(options),
       parallel_(parallel),
       max_pending_updates_(std::max(1, max_pending_updates)),
       wait_when_behind_(wait_when_behind),
-      inline_lag_(std::max(0, inline_lag)),
+      lag_(std::max(0, lag)),
       mapper_(camera, options) {
   if (parallel_) thread_ = std::thread(&MappingWorker::ThreadLoop, this);
 }
@@ -36,44 +35,59 @@ MappingWorker::~MappingWorker() {
   }
 }
 
-double MappingWorker::Submit(MappingJob job) {
+void MappingWorker::Submit(MappingJob job) {
   if (!parallel_) {
     if (job.kind == MappingJob::Kind::kUpdate) {
       held_back_.push_back(std::move(job));
-      while (static_cast<int>(held_back_.size()) > inline_lag_) RunOldestHeldBack();
+      while (static_cast<int>(held_back_.size()) > lag_) RunOldestHeldBack();
     } else {
       Flush();
       Run(job);
     }
-    return 0.0;
+    return;
   }
-  double wait_ms = 0.0;
   {
-    std::unique_lock<std::mutex> lock(mutex_);
-    auto pending_updates = [&] {
-      int pending = 0;
-      for (const MappingJob& queued : queue_) pending += queued.kind == MappingJob::Kind::kUpdate;
-      return pending;
+    std::lock_guard<std::mutex> lock(mutex_);
+    // Real time: the oldest pending update makes room for the newest.
+    const auto is_update = [](const QueuedJob& queued) {
+      return queued.job.kind == MappingJob::Kind::kUpdate;
     };
-    if (job.kind == MappingJob::Kind::kUpdate && pending_updates() >= max_pending_updates_) {
-      if (wait_when_behind_) {
-        const auto start = WallClock::now();
-        job_done_.wait(lock, [&] { return pending_updates() < max_pending_updates_; });
-        wait_ms = MsSince(start);
-      } else {
-        for (auto it = queue_.begin(); it != queue_.end(); ++it) {
-          if (it->kind == MappingJob::Kind::kUpdate) {
-            queue_.erase(it);
-            ++dropped_updates_;
-            break;
-          }
-        }
-      }
+    if (job.kind == MappingJob::Kind::kUpdate && !wait_when_behind_ &&
+        std::count_if(queue_.begin(), queue_.end(), is_update) >= max_pending_updates_) {
+      queue_.erase(std::find_if(queue_.begin(), queue_.end(), is_update));
+      ++dropped_updates_;
     }
-    queue_.push_back(std::move(job));
+    ++submitted_seq_;
+    if (job.kind != MappingJob::Kind::kUpdate) barrier_seq_ = submitted_seq_;
+    queue_.push_back({submitted_seq_, std::move(job)});
   }
   job_ready_.notify_one();
-  return wait_ms;
+}
+
+std::shared_ptr<const KeyframeMap> MappingWorker::MapForTracking(int keyframe_id) {
+  if (!parallel_) return Latest();  // the held-back updates are the lag
+  if (!wait_when_behind_) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (latest_ != nullptr && latest_->keyframe_id == keyframe_id) return latest_;
+    }
+    return WaitForKeyframe(keyframe_id);
+  }
+  // Every job but the newest lag_ updates after the last other job, whatever ran since: the
+  // inline schedule, so both modes give the same run.
+  std::unique_lock<std::mutex> lock(mutex_);
+  const int64_t required = RequiredSeq();
+  job_done_.wait(lock, [&] { return done_seq_ >= required; });
+  TrimHistory();
+  return history_.empty() ? latest_ : history_.front().second;
+}
+
+int64_t MappingWorker::RequiredSeq() const { return std::max(barrier_seq_, submitted_seq_ - lag_); }
+
+void MappingWorker::TrimHistory() {
+  // Never asked for again: what precedes the newest state a tracking frame may still need.
+  const int64_t required = RequiredSeq();
+  while (history_.size() > 1 && history_[1].first <= required) history_.pop_front();
 }
 
 std::shared_ptr<const KeyframeMap> MappingWorker::Latest() const {
@@ -144,19 +158,24 @@ int MappingWorker::idepth_corrections_applied() const {
 
 void MappingWorker::ThreadLoop() {
   while (true) {
-    MappingJob job;
+    QueuedJob queued;
     {
       std::unique_lock<std::mutex> lock(mutex_);
       job_ready_.wait(lock, [&] { return stop_ || !queue_.empty(); });
       if (queue_.empty()) return;  // stop_ and nothing left
-      job = std::move(queue_.front());
+      queued = std::move(queue_.front());
       queue_.pop_front();
       busy_ = true;
     }
-    Run(job);
+    Run(queued.job);
     {
       std::lock_guard<std::mutex> lock(mutex_);
       busy_ = false;
+      done_seq_ = queued.seq;
+      if (wait_when_behind_) {
+        history_.emplace_back(queued.seq, latest_);
+        TrimHistory();
+      }
     }
     job_done_.notify_all();
   }

@@ -6,18 +6,24 @@
 // immutable KeyframeMap: the regularised map and the tracking reference points built from it
 // (reference_builder.h), which the tracking thread picks up without copying the filter state.
 //
-// Ordering: jobs run in submission order. When more than `max_pending_updates` frame updates wait
-// in parallel mode, the oldest waiting update is dropped (counted in dropped_updates()); keyframe
-// and line-depth / depth-correction jobs are never dropped. Inline, frame updates can be held back
-// by `inline_lag` later submissions (the lag of a mapping thread, deterministically).
+// Ordering: jobs run in submission order. The map a frame is tracked against (MapForTracking)
+// holds every job submitted so far but the newest `lag` frame updates after the last other job,
+// whichever thread ran them: inline, the updates are held back that long; in parallel with
+// wait_when_behind, the tracking waits for that state and gets it even when the thread is ahead,
+// so a parallel run is the inline run. Without wait_when_behind (real time), the tracking gets
+// the latest map, and when more than `max_pending_updates` frame updates wait the oldest is
+// dropped (counted in dropped_updates()); keyframe and line-depth / depth-correction jobs are
+// never dropped.
 #ifndef PLDVO_BACKEND_ODOMETRY_MAPPING_WORKER_H_
 #define PLDVO_BACKEND_ODOMETRY_MAPPING_WORKER_H_
 
 #include <condition_variable>
+#include <cstdint>
 #include <deque>
 #include <memory>
 #include <mutex>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "backend/mapping/depth_mapper.h"
@@ -93,25 +99,23 @@ struct MappingJob {
 class MappingWorker {
  public:
   // Throws std::invalid_argument on invalid camera or options.
-  // With wait_when_behind, Submit blocks while max_pending_updates frame updates are pending
-  // instead of dropping the oldest: the map then sees every frame whatever the machine's load.
-  // Inline (not parallel), an update runs once `inline_lag` later updates were submitted, or
+  // With wait_when_behind no update is dropped: the map sees every frame whatever the machine's
+  // load. Inline (not parallel), an update runs once `lag` later updates were submitted, or
   // before the next keyframe or line-depth job, or at Flush.
   MappingWorker(const PinholeCamera& camera, const MappingOptions& options, bool parallel,
-                int max_pending_updates, bool wait_when_behind = false, int inline_lag = 0);
+                int max_pending_updates, bool wait_when_behind = false, int lag = 0);
   ~MappingWorker();
   MappingWorker(const MappingWorker&) = delete;
   MappingWorker& operator=(const MappingWorker&) = delete;
 
   // Runs the job inline (not parallel; updates may be held back, see the constructor) or queues
-  // it. A job that throws is counted in failed_jobs() and leaves the map as it was. Returns the
-  // ms spent waiting for the mapping thread to catch up (wait_when_behind), else 0.
-  double Submit(MappingJob job);
+  // it; never blocks. A job that throws is counted in failed_jobs() and leaves the map as it was.
+  void Submit(MappingJob job);
+  // The map the next frame is tracked against (see Ordering above); blocks until the mapping
+  // thread has run the jobs it needs. Real time: the latest, once keyframe_id's is published.
+  std::shared_ptr<const KeyframeMap> MapForTracking(int keyframe_id);
   // The latest published map (nullptr before the first keyframe).
   std::shared_ptr<const KeyframeMap> Latest() const;
-  // Blocks until the published map belongs to keyframe_id (or the worker failed it); returns
-  // the latest map.
-  std::shared_ptr<const KeyframeMap> WaitForKeyframe(int keyframe_id);
   // Blocks until every submitted job has run.
   void Flush();
 
@@ -128,9 +132,15 @@ class MappingWorker {
 
  private:
   void Run(const MappingJob& job);
+  // Blocks until the published map belongs to keyframe_id (or the worker failed it); returns
+  // the latest map.
+  std::shared_ptr<const KeyframeMap> WaitForKeyframe(int keyframe_id);
   // The job's keyframe with the random initial map (options.init); restarts the update count.
   void InitializeRandomMap(const MappingJob& job, KeyframeMap* published);
   void RunOldestHeldBack();
+  // Parallel with wait_when_behind: the job after which MapForTracking's map was published.
+  int64_t RequiredSeq() const;
+  void TrimHistory();
   void Publish(std::shared_ptr<KeyframeMap> keyframe_map);
   void ThreadLoop();
 
@@ -139,8 +149,8 @@ class MappingWorker {
   bool parallel_;
   int max_pending_updates_;
   bool wait_when_behind_;
-  int inline_lag_;
-  std::deque<MappingJob> held_back_;  // inline: updates waiting for inline_lag_ later ones
+  int lag_;
+  std::deque<MappingJob> held_back_;  // inline: updates waiting for lag_ later ones
   DepthMapper mapper_;                // touched only by the job runner
   ImagePyramid keyframe_levels_;      // the keyframe's pyramid for the reference intensities
   int keyframe_id_ = -1;
@@ -150,7 +160,17 @@ class MappingWorker {
   mutable std::mutex mutex_;
   std::condition_variable job_ready_;
   std::condition_variable job_done_;
-  std::deque<MappingJob> queue_;
+  struct QueuedJob {
+    int64_t seq = 0;  // 1, 2, ... in submission order
+    MappingJob job;
+  };
+  std::deque<QueuedJob> queue_;
+  int64_t submitted_seq_ = 0;
+  int64_t barrier_seq_ = 0;  // the newest job that is not a frame update
+  int64_t done_seq_ = 0;
+  // Parallel with wait_when_behind: the map published after each job, from the oldest that
+  // MapForTracking may still return.
+  std::deque<std::pair<int64_t, std::shared_ptr<const KeyframeMap>>> history_;
   bool busy_ = false;
   bool stop_ = false;
   std::shared_ptr<const KeyframeMap> latest_;

@@ -90,7 +90,7 @@ Odometry::Odometry(const PinholeCamera& camera, const OdometryConfig& config,
   mapper_ = std::make_unique<MappingWorker>(
       camera_, config_.mapping, config_.odometry.parallel_mapping,
       config_.odometry.mapping_queue_size, config_.odometry.wait_for_mapping,
-      config_.odometry.inline_mapping_lag);
+      config_.odometry.mapping_lag);
   const EdgeBAOptions& edge_ba = config_.backend.edge_ba;
   if (edge_ba.enabled) {
     edge_ba_window_ = std::make_unique<KeyframeWindow>(camera_, edge_ba.window,
@@ -457,24 +457,20 @@ void Odometry::NoteKeyframeMap(const KeyframeMap& map) {
 }
 
 void Odometry::RefreshMap(OdometryTiming* timing) {
-  if (map_ == nullptr || map_->keyframe_id != keyframe_.id) {
-    const auto start = WallClock::now();
-    map_ = mapper_->WaitForKeyframe(keyframe_.id);
-    timing->wait_ms += MsSince(start);
-    if (map_ != nullptr) {
-      NotifyRetired(*map_);
-      NoteKeyframeMap(*map_);
-      if (windowed_ba_keyframes_ != nullptr) {
-        UpdateWindowedBA(*map_);
-        // Synchronous: the depth corrections of the current keyframe are already published.
-        if (windowed_ba_adjuster_ == nullptr) {
-          const std::shared_ptr<const KeyframeMap> latest = mapper_->Latest();
-          if (latest != nullptr && latest->keyframe_id == map_->keyframe_id) map_ = latest;
-        }
-      }
+  const bool keyframe_changed = map_ == nullptr || map_->keyframe_id != keyframe_.id;
+  const auto start = WallClock::now();
+  map_ = mapper_->MapForTracking(keyframe_.id);
+  timing->wait_ms += MsSince(start);
+  if (!keyframe_changed || map_ == nullptr) return;
+  NotifyRetired(*map_);
+  NoteKeyframeMap(*map_);
+  if (windowed_ba_keyframes_ != nullptr) {
+    UpdateWindowedBA(*map_);
+    // Synchronous: the depth corrections of the current keyframe are already published.
+    if (windowed_ba_adjuster_ == nullptr) {
+      const std::shared_ptr<const KeyframeMap> latest = mapper_->Latest();
+      if (latest != nullptr && latest->keyframe_id == map_->keyframe_id) map_ = latest;
     }
-  } else {
-    map_ = mapper_->Latest();
   }
 }
 
@@ -753,7 +749,7 @@ void Odometry::MapOrSwitchKeyframe(int index, double timestamp, const cv::Mat& i
   job.pose_covariance = tracking.pose_covariance;
   job.brightness = brightness_;
   job.lines_in_cur = std::move(association.lines_in_cur);
-  timing.wait_ms += mapper_->Submit(std::move(job));
+  mapper_->Submit(std::move(job));
 }
 
 void Odometry::HandleLostFrame(int index, double timestamp, const cv::Mat& image, LineFrame lines,

@@ -33,7 +33,7 @@ std::string OdometryOptions::Check() const {
   if (reinit_after_lost < 1) return "reinit_after_lost must be >= 1";
   if (reinit_min_points < 0) return "reinit_min_points must be >= 0";
   if (mapping_queue_size < 1) return "mapping_queue_size must be >= 1";
-  if (inline_mapping_lag < 0) return "inline_mapping_lag must be >= 0";
+  if (mapping_lag < 0) return "mapping_lag must be >= 0";
   if (!(init_depth_idepth_var >= 0.0)) return "init_depth_idepth_var must be >= 0";
   if (bootstrap_passes < 1) return "bootstrap_passes must be >= 1";
   if (!(bootstrap_idepth_var > 0.0) || !std::isfinite(bootstrap_idepth_var)) {

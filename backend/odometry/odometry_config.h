@@ -132,13 +132,15 @@ struct OdometryOptions {
   int reinit_after_lost = 3;
   int reinit_min_points = 500;
   // Mapping in its own thread (default). false: mapping runs on the caller's thread after each
-  // frame, deterministic (the tests).
+  // frame; with wait_for_mapping both give the same run (mapping_lag).
   bool parallel_mapping = true;
-  // parallel_mapping false: a frame's map update runs only after this many later frames were
-  // tracked, so the tracking sees a map that lags like the mapping thread's (0: the newest frame;
-  // with wait_for_mapping, once mapping is the bottleneck, the thread's schedule is a lag of
-  // mapping_queue_size + 1). Keyframe switches first run every held-back update, in order.
-  int inline_mapping_lag = 0;
+  // Frame updates the map a frame is tracked against may lack: the newest `mapping_lag` frames'
+  // stereo updates (since the last keyframe switch) are not in it yet, every older one is. Inline
+  // they are held back; on the mapping thread (with wait_for_mapping) the tracking waits for
+  // exactly that map, which lets mapping overlap `mapping_lag` frames of tracking and gives the
+  // inline run's results. 0: every frame sees its predecessor's update (no overlap; the most
+  // accurate, docs/odometry.md "Mapping lag").
+  int mapping_lag = 0;
   // `pldvo run`: the per-image work of frame i + 1 (pyramid, line detection, merging and LBD;
   // FramePreparer) runs on the loading thread while frame i is tracked. It is a pure function of
   // the image, so results do not change; tracking_thread then leaves it out, and the frame period
@@ -146,12 +148,12 @@ struct OdometryOptions {
   // on textured frames; with the mapping thread on 2 cores the three threads share them and the
   // frame period grows (docs/odometry.md, "Threading"). false: all of it on the tracking thread.
   bool frontend_thread = false;
-  // Pending mapping updates kept when the mapping thread falls behind; older pending frames are
-  // dropped (counted). Keyframe creations are never dropped.
+  // wait_for_mapping false: pending mapping updates kept when the mapping thread falls behind;
+  // older pending frames are dropped (counted). Keyframe creations are never dropped.
   int mapping_queue_size = 2;
-  // When mapping_queue_size updates are pending, wait for the mapping thread instead of dropping
-  // the oldest: every tracked frame updates the map, so results do not depend on the machine's
-  // load (the wait is reported as `wait`). false: real-time behaviour, updates are dropped.
+  // Wait for the mapping thread (mapping_lag) instead of dropping updates: every tracked frame
+  // updates the map, so results do not depend on the machine's load (the wait is reported as
+  // `wait`). false: real-time behaviour, the latest map is used and updates are dropped.
   bool wait_for_mapping = true;
   // Evaluation aid, off by default (monocular): initialise the first keyframe's map from the
   // first frame's depth image (TUM layout: 16-bit PNG, metres x 5000) with this inverse-depth
@@ -222,16 +224,20 @@ struct OdometryOptions {
     v.Field("reinit_min_points", &reinit_min_points,
             "Propagated hypotheses needed to keep the map on re-initialisation (default 500).");
     v.Field("parallel_mapping", &parallel_mapping,
-            "Mapping in its own thread; false runs it inline (deterministic).");
-    v.Field("inline_mapping_lag", &inline_mapping_lag,
-            "parallel_mapping false: frames tracked before a frame's map update runs (default 0).");
+            "Mapping in its own thread; false runs it on the tracking thread (the same run with "
+            "wait_for_mapping).");
+    v.Field("mapping_lag", &mapping_lag,
+            "Newest frame updates missing from the map a frame is tracked against, inline and "
+            "on the mapping thread with wait_for_mapping (the same run); 0 = none (default 0).");
     v.Field("frontend_thread", &frontend_thread,
             "pldvo run: prepare frame i + 1 (pyramid, lines, LBD) on the loading thread while "
             "frame i is tracked (default false); results are unchanged.");
     v.Field("mapping_queue_size", &mapping_queue_size,
-            "Pending mapping updates kept when mapping falls behind (default 2).");
+            "wait_for_mapping false: pending mapping updates kept before the oldest is dropped "
+            "(default 2).");
     v.Field("wait_for_mapping", &wait_for_mapping,
-            "Wait for the mapping thread when the queue is full instead of dropping updates.");
+            "Wait for the mapping thread (mapping_lag) instead of using the latest map and "
+            "dropping updates (default true).");
     v.Field("init_depth_idepth_var", &init_depth_idepth_var,
             "Evaluation aid: > 0 initialises the first keyframe from the dataset's depth image "
             "with this inverse-depth variance, (1/m)^2; 0 = monocular random init (default).");

@@ -261,6 +261,32 @@ TEST(OdometryTest, FramesPreparedOnAnotherThreadGiveTheSameRun) {
       std::invalid_argument);
 }
 
+TEST(OdometryTest, TheMappingThreadGivesTheInlineRun) {
+  // odometry.mapping_lag: with wait_for_mapping the tracking waits for the map the inline run
+  // has, however far ahead or behind the mapping thread is, so both runs are the same.
+  for (const int lag : {0, 2}) {
+    SCOPED_TRACE("mapping_lag " + std::to_string(lag));
+    OdometryConfig config = DeterministicConfig();
+    config.odometry.mapping_lag = lag;
+    const RunResult inline_run = RunSequence(config, {}, kRepeatFrames);
+    config.odometry.parallel_mapping = true;
+    const RunResult threaded = RunSequence(config, {}, kRepeatFrames);
+    ASSERT_EQ(threaded.frames.size(), inline_run.frames.size());
+    EXPECT_GE(inline_run.stats.keyframes, 2);
+    for (size_t i = 0; i < inline_run.frames.size(); ++i) {
+      const OdometryFrameResult& expected = inline_run.frames[i];
+      const OdometryFrameResult& frame = threaded.frames[i];
+      ASSERT_EQ(frame.status, expected.status) << "frame " << i;
+      EXPECT_EQ(frame.num_reference_points, expected.num_reference_points) << "frame " << i;
+      EXPECT_EQ(frame.world_from_cam.translation(), expected.world_from_cam.translation())
+          << "frame " << i;
+      EXPECT_EQ(frame.world_from_cam.rotation().coeffs(),
+                expected.world_from_cam.rotation().coeffs())
+          << "frame " << i;
+    }
+  }
+}
+
 TEST(OdometryTest, CompareSolverSolvesTheSameProblemsWithoutChangingTheRun) {
   // The run without the comparison, on the repeatability prefix: a deterministic run's first
   // frames do not depend on how many follow.

@@ -201,15 +201,15 @@ MappingJob UpdateJob(int keyframe_id, int frame_index, const cv::Mat& image) {
 }
 
 TEST(MappingWorkerTest, WaitingWhenBehindRunsEveryUpdate) {
-  // A burst of updates submitted faster than the thread maps them: with wait_when_behind the
-  // submitter blocks instead, so no update is dropped and every job runs.
+  // A burst of updates submitted faster than the thread maps them: with wait_when_behind none is
+  // dropped and every job runs.
   MappingOptions options;
   MappingWorker worker(Camera(), options, /*parallel=*/true, /*max_pending_updates=*/1,
                        /*wait_when_behind=*/true);
   const cv::Mat image = Texture();
   worker.Submit(KeyframeJob(MappingJob::Kind::kInitialize, 0, 0, image));
   constexpr int kUpdates = 30;
-  for (int i = 1; i <= kUpdates; ++i) EXPECT_GE(worker.Submit(UpdateJob(0, i, image)), 0.0);
+  for (int i = 1; i <= kUpdates; ++i) worker.Submit(UpdateJob(0, i, image));
   worker.Flush();
   EXPECT_EQ(worker.dropped_updates(), 0);
   EXPECT_EQ(worker.failed_jobs(), 0);
@@ -248,6 +248,43 @@ TEST(MappingWorkerTest, InlineLagHoldsUpdatesBackUntilTheNextKeyframe) {
   EXPECT_EQ(worker.Latest()->num_updates, 0);
   worker.Flush();
   EXPECT_EQ(worker.Latest()->num_updates, 1);
+}
+
+TEST(MappingWorkerTest, TrackingGetsTheLaggedMapOnEitherThread) {
+  // MapForTracking with a lag of 2: every update but the newest two, inline and on the thread,
+  // even when the thread has already run them all; after a keyframe switch, the new keyframe's
+  // map.
+  constexpr int kLag = 2;
+  const cv::Mat image = Texture();
+  for (const bool parallel : {false, true}) {
+    SCOPED_TRACE(parallel ? "parallel" : "inline");
+    MappingOptions options;
+    MappingWorker worker(Camera(), options, parallel, /*max_pending_updates=*/1,
+                         /*wait_when_behind=*/true, kLag);
+    worker.Submit(KeyframeJob(MappingJob::Kind::kInitialize, 0, 0, image));
+    ASSERT_NE(worker.MapForTracking(0), nullptr);
+    EXPECT_EQ(worker.MapForTracking(0)->num_updates, 0);
+    constexpr int kUpdates = 5;
+    for (int i = 1; i <= kUpdates; ++i) {
+      worker.Submit(UpdateJob(0, i, image));
+      if (parallel) worker.Flush();  // inline, Flush runs the held-back updates
+      EXPECT_EQ(worker.MapForTracking(0)->num_updates, std::max(0, i - kLag)) << "update " << i;
+    }
+    if (parallel) EXPECT_EQ(worker.Latest()->num_updates, kUpdates);
+    MappingJob next = KeyframeJob(MappingJob::Kind::kNewKeyframe, 1, kUpdates + 1, image);
+    next.new_from_old = SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(-0.06, 0.0, 0.0));
+    worker.Submit(std::move(next));
+    const std::shared_ptr<const KeyframeMap> switched = worker.MapForTracking(1);
+    EXPECT_EQ(switched->keyframe_id, 1);
+    EXPECT_EQ(switched->num_updates, 0);
+    worker.Submit(UpdateJob(1, kUpdates + 2, image));
+    worker.Submit(UpdateJob(1, kUpdates + 3, image));
+    EXPECT_EQ(worker.MapForTracking(1)->num_updates, 0);
+    worker.Submit(UpdateJob(1, kUpdates + 4, image));
+    EXPECT_EQ(worker.MapForTracking(1)->num_updates, 1);
+    EXPECT_EQ(worker.dropped_updates(), 0);
+    EXPECT_EQ(worker.failed_jobs(), 0);
+  }
 }
 
 TEST(MappingWorkerTest, CountsTheUpdatesSinceTheLastRandomInitialisation) {
