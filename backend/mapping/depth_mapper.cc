@@ -6,9 +6,11 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "backend/mapping/depth_regularizer.h"
 #include "backend/mapping/line_stereo.h"
+#include "backend/mapping/pixel_stripes.h"
 #include "core/wall_clock.h"
 
 namespace pldvo {
@@ -19,6 +21,21 @@ DepthMapper::DepthMapper(const PinholeCamera& camera, const MappingOptions& opti
   if (!camera_error.empty()) throw std::invalid_argument("DepthMapper: camera: " + camera_error);
   const std::string error = options.Check();
   if (!error.empty()) throw std::invalid_argument("DepthMapper: " + error);
+}
+
+void FrameUpdateStats::AddCounts(const FrameUpdateStats& other) {
+  line_attempts += other.line_attempts;
+  line_ok += other.line_ok;
+  line_refined += other.line_refined;
+  line_fallback += other.line_fallback;
+  line_rejected += other.line_rejected;
+  line_out_of_range += other.line_out_of_range;
+  ssd_attempts += other.ssd_attempts;
+  ssd_ok += other.ssd_ok;
+  fused += other.fused;
+  created += other.created;
+  outliers += other.outliers;
+  num_edge_pixels += other.num_edge_pixels;
 }
 
 void DepthMapper::SetKeyframe(const cv::Mat& image, const EdgeTrace& edges) {
@@ -246,15 +263,23 @@ FrameUpdateStats DepthMapper::UpdateWithFrame(const cv::Mat& image, const SE3& c
     }
     lines = &kept;
   }
-  // Two passes (edge pixels, then the rest) so that each is timed on its own.
+  // Two passes (edge pixels, then the rest) so that each is timed on its own, each in stripes of
+  // pixels (pixel_stripes.h).
+  const int stripes = NumStripes(options_);
   for (int pass = 0; pass < 2; ++pass) {
     const auto start = WallClock::now();
-    for (int i = 0; i < map_.num_pixels(); ++i) {
-      if (!map_.candidate(i) || (map_.edge_id(i) >= 0) != (pass == 0)) continue;
-      if (map_.blacklist(i) >= options_.blacklist_threshold) continue;
-      if (pass == 0) ++stats.num_edge_pixels;
-      UpdatePixel(i, current, geometry, *lines, &stats);
-    }
+    std::vector<FrameUpdateStats> stripe_stats(stripes);
+    ForEachStripe(stripes, [&](int stripe) {
+      FrameUpdateStats* counts = &stripe_stats[stripe];
+      const int end = map_.num_pixels() * (stripe + 1) / stripes;
+      for (int i = map_.num_pixels() * stripe / stripes; i < end; ++i) {
+        if (!map_.candidate(i) || (map_.edge_id(i) >= 0) != (pass == 0)) continue;
+        if (map_.blacklist(i) >= options_.blacklist_threshold) continue;
+        if (pass == 0) ++counts->num_edge_pixels;
+        UpdatePixel(i, current, geometry, *lines, counts);
+      }
+    });
+    for (const FrameUpdateStats& counts : stripe_stats) stats.AddCounts(counts);
     (pass == 0 ? stats.edge_stereo_ms : stats.other_stereo_ms) = MsSince(start);
   }
   if (options_.regularize) {

@@ -62,6 +62,9 @@ struct FrameUpdateStats {
   int num_edge_pixels = 0;       // candidates on an edge that were processed
   double edge_stereo_ms = 0.0;   // wall time of the stereo on edge pixels
   double other_stereo_ms = 0.0;  // wall time of the stereo on all other pixels
+
+  // Adds the per-pixel counters of `other` (line_* to created, num_edge_pixels).
+  void AddCounts(const FrameUpdateStats& other);
 };
 
 // FuseLineDepths: what happened to the valid pixels on edges with a line.

@@ -1,7 +1,10 @@
 #include "backend/mapping/depth_regularizer.h"
 
 #include <algorithm>
+#include <numeric>
 #include <vector>
+
+#include "backend/mapping/pixel_stripes.h"
 
 namespace pldvo {
 namespace {
@@ -49,38 +52,43 @@ int SmoothDepthMap(const SemiDenseDepthMap& in, const MappingOptions& options,
   const int r = options.regularization_radius;
   const double gate_sq = options.regularization_gate_sigmas * options.regularization_gate_sigmas;
   const ValidRows rows(in);
-  // Per window row, the first hypothesis not left of the window of the current pixel: the
-  // pixels of a row come in increasing x, so the cursors only move forward.
-  std::vector<const Hypothesis*> first(2 * r + 1);
-  int smoothed = 0;
-  for (int y = 0; y < in.height(); ++y) {
-    const int y0 = std::max(y - r, 0), y1 = std::min(y + r, in.height() - 1);
-    for (int yy = y0; yy <= y1; ++yy) first[yy - y0] = rows.begin(yy);
-    for (const Hypothesis* h_i = rows.begin(y); h_i != rows.end(y); ++h_i) {
-      const int x = h_i->x;
-      const double d_i = h_i->idepth, v_i = h_i->idepth_var;
-      double sum = h_i->weighted, sum_info = h_i->info;
-      int neighbours = 0;
-      for (int yy = y0; yy <= y1; ++yy) {
-        const Hypothesis* const end = rows.end(yy);
-        const Hypothesis*& begin = first[yy - y0];
-        while (begin != end && begin->x < x - r) ++begin;
-        for (const Hypothesis* h_j = begin; h_j != end && h_j->x <= x + r; ++h_j) {
-          if (h_j == h_i) continue;
-          const double d_j = h_j->idepth, v_j = h_j->idepth_var;
-          if ((d_i - d_j) * (d_i - d_j) > gate_sq * (v_i + v_j)) continue;
-          sum += h_j->weighted;
-          sum_info += h_j->info;
-          ++neighbours;
+  // In stripes of rows (pixel_stripes.h): each writes only its own pixels.
+  const int stripes = NumStripes(options);
+  std::vector<int> smoothed(stripes, 0);
+  ForEachStripe(stripes, [&](int stripe) {
+    // Per window row, the first hypothesis not left of the window of the current pixel: the
+    // pixels of a row come in increasing x, so the cursors only move forward.
+    std::vector<const Hypothesis*> first(2 * r + 1);
+    const int y_end = in.height() * (stripe + 1) / stripes;
+    for (int y = in.height() * stripe / stripes; y < y_end; ++y) {
+      const int y0 = std::max(y - r, 0), y1 = std::min(y + r, in.height() - 1);
+      for (int yy = y0; yy <= y1; ++yy) first[yy - y0] = rows.begin(yy);
+      for (const Hypothesis* h_i = rows.begin(y); h_i != rows.end(y); ++h_i) {
+        const int x = h_i->x;
+        const double d_i = h_i->idepth, v_i = h_i->idepth_var;
+        double sum = h_i->weighted, sum_info = h_i->info;
+        int neighbours = 0;
+        for (int yy = y0; yy <= y1; ++yy) {
+          const Hypothesis* const end = rows.end(yy);
+          const Hypothesis*& begin = first[yy - y0];
+          while (begin != end && begin->x < x - r) ++begin;
+          for (const Hypothesis* h_j = begin; h_j != end && h_j->x <= x + r; ++h_j) {
+            if (h_j == h_i) continue;
+            const double d_j = h_j->idepth, v_j = h_j->idepth_var;
+            if ((d_i - d_j) * (d_i - d_j) > gate_sq * (v_i + v_j)) continue;
+            sum += h_j->weighted;
+            sum_info += h_j->info;
+            ++neighbours;
+          }
+        }
+        if (neighbours > 0) {
+          out->SetIdepth(in.Index(x, y), sum / sum_info);
+          ++smoothed[stripe];
         }
       }
-      if (neighbours > 0) {
-        out->SetIdepth(in.Index(x, y), sum / sum_info);
-        ++smoothed;
-      }
     }
-  }
-  return smoothed;
+  });
+  return std::accumulate(smoothed.begin(), smoothed.end(), 0);
 }
 
 int RemoveIsolatedHypotheses(const MappingOptions& options, SemiDenseDepthMap* map) {

@@ -54,6 +54,7 @@ std::string MappingOptions::Check() const {
     error << "min_inlier_ratio must be in [0, 1); ";
   }
   if (blacklist_threshold <= 0) error << "blacklist_threshold must be > 0; ";
+  if (num_threads < 0) error << "num_threads must be >= 0; ";
   if (max_reference_points < 0) error << "max_reference_points must be >= 0; ";
   if (regularization_radius < 1) error << "regularization_radius must be >= 1; ";
   if (regularization_gate_sigmas <= 0.0) error << "regularization_gate_sigmas must be > 0; ";

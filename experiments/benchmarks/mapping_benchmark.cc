@@ -1,7 +1,8 @@
 // The parts of one mapping job (docs/odometry.md, Table III "mapping") on a synthetic `textured`
 // 640x480 keyframe with its ground-truth edges, a map warmed up by 7 frames with ground-truth
 // poses and line matches (frames 2, 4, ..., 14; the library's default MappingOptions):
-//   Mapping/update           the stereo + EKF update with frame 16 (DepthMapper::UpdateWithFrame)
+//   Mapping/update           the stereo + EKF update with frame 16 (DepthMapper::UpdateWithFrame),
+//                            num_threads:1 on the calling thread, :0 the default (all cores)
 //   Mapping/regularized/...  RegularizedMap: smoothing (smooth:1) and 3D line regularisation
 //                            (lines:1), what every job publishes
 //   Mapping/reference        BuildReferencePoints of the published map (4000 points per level)
@@ -34,6 +35,8 @@ struct Fixture {
   PinholeCamera camera;
   MappingOptions options;
   DepthMapper mapper;  // after the warm-up frames
+  // The same with options.num_threads = 1 (the stereo pass on the calling thread alone).
+  DepthMapper one_thread_mapper;
   cv::Mat next_image;  // frame 16
   SE3 next_from_ref;
   std::vector<MatchedLine> next_lines;
@@ -50,9 +53,18 @@ const Fixture& GetFixture() {
         synthetic_pairs::SegmentsInCam(sequence.scene, world_from_ref.Inverse()), keyframe.depth,
         sequence.camera, GroundTruthEdgeOptions());
     const MappingOptions options;
-    auto* f = new Fixture{
-        sequence.camera, options, DepthMapper(sequence.camera, options), {}, {}, {}, {}};
+    MappingOptions one_thread = options;
+    one_thread.num_threads = 1;
+    auto* f = new Fixture{sequence.camera,
+                          options,
+                          DepthMapper(sequence.camera, options),
+                          DepthMapper(sequence.camera, one_thread),
+                          {},
+                          {},
+                          {},
+                          {}};
     f->mapper.InitializeKeyframe(keyframe.image, edges.trace);
+    f->one_thread_mapper.InitializeKeyframe(keyframe.image, edges.trace);
     for (int k = 1; k <= kWarmupFrames + 1; ++k) {
       const int index = kKeyframe + k * kStride;
       const cv::Mat image = synthetic::RenderFrame(sequence, index).image;
@@ -62,6 +74,7 @@ const Fixture& GetFixture() {
           ProjectGroundTruthLines(edges, sequence.camera, cur_from_ref, 0.25, 17 + k);
       if (k <= kWarmupFrames) {
         f->mapper.UpdateWithFrame(image, cur_from_ref, lines);
+        f->one_thread_mapper.UpdateWithFrame(image, cur_from_ref, lines);
       } else {
         f->next_image = image;
         f->next_from_ref = cur_from_ref;
@@ -77,12 +90,13 @@ const Fixture& GetFixture() {
 void BM_Update(benchmark::State& state) {
   const Fixture& fixture = GetFixture();
   FrameUpdateStats stats;
+  const DepthMapper& warmed = state.range(0) == 1 ? fixture.one_thread_mapper : fixture.mapper;
   // Copy-assigned before every update (not timed) into the same object, whose buffers keep their
   // capacity: a fresh copy would make the update's own allocations land on freshly mapped pages.
-  DepthMapper mapper = fixture.mapper;
+  DepthMapper mapper = warmed;
   for (auto _ : state) {
     state.PauseTiming();
-    mapper = fixture.mapper;
+    mapper = warmed;
     state.ResumeTiming();
     stats = mapper.UpdateWithFrame(fixture.next_image, fixture.next_from_ref, fixture.next_lines);
     benchmark::DoNotOptimize(stats);
@@ -192,7 +206,13 @@ void BM_InPlaceStep(benchmark::State& state) {
   state.counters["changed"] = changed;
 }
 
-BENCHMARK(BM_Update)->Name("Mapping/update")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Update)
+    ->Name("Mapping/update")
+    ->ArgName("num_threads")
+    ->Arg(1)
+    ->Arg(0)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(BM_Regularized)
     ->Name("Mapping/regularized")
     ->ArgNames({"smooth", "lines"})

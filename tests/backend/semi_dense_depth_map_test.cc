@@ -782,10 +782,16 @@ TEST(DepthRegularizerTest, MatchesTheReferenceBitForBit) {
         const SemiDenseDepthMap map =
             RandomSparseMap(width, height, 7 * radius + static_cast<int>(gate_sigmas));
 
-        SemiDenseDepthMap smoothed, expected_smoothed;
-        EXPECT_EQ(SmoothDepthMap(map, options, &smoothed),
-                  ReferenceSmoothDepthMap(map, options, &expected_smoothed));
-        ExpectIdenticalMaps(smoothed, expected_smoothed);
+        SemiDenseDepthMap expected_smoothed;
+        const int expected_count = ReferenceSmoothDepthMap(map, options, &expected_smoothed);
+        // In one stripe of rows and in three (mapping.num_threads; the 3x2 map leaves one
+        // stripe without a row).
+        for (const int threads : {1, 3}) {
+          options.num_threads = threads;
+          SemiDenseDepthMap smoothed;
+          EXPECT_EQ(SmoothDepthMap(map, options, &smoothed), expected_count) << threads;
+          ExpectIdenticalMaps(smoothed, expected_smoothed);
+        }
 
         if (width < 10) continue;
         // The map exercises what the comparison must catch: smoothing changes most hypotheses
