@@ -221,6 +221,17 @@ TEST(OdometryTest, DeterministicModeRepeatsExactly) {
 // cm/s (0.3%). A solver that failed on some frames would differ by millimetres.
 // odometry.frontend_thread: frames prepared (pyramid, lines, LBD) on another thread, one ahead,
 // as `pldvo run` does, give the run of ProcessFrame(image) bit for bit.
+// The same frame of two runs that must be identical: status, counts and the pose bit for bit.
+void ExpectSameFrame(const OdometryFrameResult& frame, const OdometryFrameResult& expected) {
+  SCOPED_TRACE("frame " + std::to_string(expected.index));
+  EXPECT_EQ(frame.status, expected.status);
+  EXPECT_EQ(frame.num_lines, expected.num_lines);
+  EXPECT_EQ(frame.num_matches, expected.num_matches);
+  EXPECT_EQ(frame.num_reference_points, expected.num_reference_points);
+  EXPECT_EQ(frame.world_from_cam.translation(), expected.world_from_cam.translation());
+  EXPECT_EQ(frame.world_from_cam.rotation().coeffs(), expected.world_from_cam.rotation().coeffs());
+}
+
 TEST(OdometryTest, FramesPreparedOnAnotherThreadGiveTheSameRun) {
   const OdometryConfig config = DeterministicConfig();
   const RunResult plain = RunSequence(config, {}, kRepeatFrames);
@@ -238,15 +249,7 @@ TEST(OdometryTest, FramesPreparedOnAnotherThreadGiveTheSameRun) {
     const OdometryFrameResult result =
         odometry.ProcessFrame(i, rendered.sequence.ground_truth[i].timestamp, std::move(frame),
                               i == 0 ? rendered.first_depth : cv::Mat());
-    const OdometryFrameResult& expected = plain.frames[i];
-    ASSERT_EQ(result.status, expected.status) << "frame " << i;
-    EXPECT_EQ(result.num_lines, expected.num_lines) << "frame " << i;
-    EXPECT_EQ(result.num_matches, expected.num_matches) << "frame " << i;
-    EXPECT_EQ(result.world_from_cam.translation(), expected.world_from_cam.translation())
-        << "frame " << i;
-    EXPECT_EQ(result.world_from_cam.rotation().coeffs(),
-              expected.world_from_cam.rotation().coeffs())
-        << "frame " << i;
+    ExpectSameFrame(result, plain.frames[i]);
   }
   odometry.Finish();
   // A prepared frame of the wrong size is refused like an image.
@@ -274,15 +277,7 @@ TEST(OdometryTest, TheMappingThreadGivesTheInlineRun) {
     ASSERT_EQ(threaded.frames.size(), inline_run.frames.size());
     EXPECT_GE(inline_run.stats.keyframes, 2);
     for (size_t i = 0; i < inline_run.frames.size(); ++i) {
-      const OdometryFrameResult& expected = inline_run.frames[i];
-      const OdometryFrameResult& frame = threaded.frames[i];
-      ASSERT_EQ(frame.status, expected.status) << "frame " << i;
-      EXPECT_EQ(frame.num_reference_points, expected.num_reference_points) << "frame " << i;
-      EXPECT_EQ(frame.world_from_cam.translation(), expected.world_from_cam.translation())
-          << "frame " << i;
-      EXPECT_EQ(frame.world_from_cam.rotation().coeffs(),
-                expected.world_from_cam.rotation().coeffs())
-          << "frame " << i;
+      ExpectSameFrame(threaded.frames[i], inline_run.frames[i]);
     }
   }
 }
