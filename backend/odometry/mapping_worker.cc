@@ -65,14 +65,8 @@ void MappingWorker::Submit(MappingJob job) {
 }
 
 std::shared_ptr<const KeyframeMap> MappingWorker::MapForTracking(int keyframe_id) {
-  if (!parallel_) return Latest();  // the held-back updates are the lag
-  if (!wait_when_behind_) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (latest_ != nullptr && latest_->keyframe_id == keyframe_id) return latest_;
-    }
-    return WaitForKeyframe(keyframe_id);
-  }
+  if (!parallel_) return Latest();                              // the held-back updates are the lag
+  if (!wait_when_behind_) return WaitForKeyframe(keyframe_id);  // the latest, once keyframe_id's
   // Every job but the newest lag_ updates after the last other job, whatever ran since: the
   // inline schedule, so both modes give the same run.
   std::unique_lock<std::mutex> lock(mutex_);
