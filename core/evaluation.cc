@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <stdexcept>
 
@@ -16,6 +17,11 @@ void RequireIncreasing(const Trajectory& trajectory, const char* name) {
                                   std::to_string(i));
     }
   }
+}
+
+// The rotation angle of q in [0, pi] (either sign of the double cover).
+double RotationAngle(const Eigen::Quaterniond& q) {
+  return 2.0 * std::atan2(q.vec().norm(), std::abs(q.w()));
 }
 
 int NearestPose(const Trajectory& trajectory, double t) {
@@ -152,9 +158,7 @@ EvaluationResult EvaluateTrajectory(const Trajectory& ground_truth, const Trajec
     const SE3 est_j_from_i(est_relative.rotation(), result.scale * est_relative.translation());
     const SE3 error = gt_j_from_i.Inverse() * est_j_from_i;
     const double trans_per_s = error.translation().norm() / interval;
-    const double angle =
-        2.0 * std::atan2(error.rotation().vec().norm(), std::abs(error.rotation().w()));
-    const double rot_per_s = angle / interval;
+    const double rot_per_s = RotationAngle(error.rotation()) / interval;
     trans_squared += trans_per_s * trans_per_s;
     rot_squared += rot_per_s * rot_per_s;
     ++result.num_pairs;
@@ -195,6 +199,58 @@ EvaluationResult EvaluateTrajectory(const Trajectory& ground_truth, const Trajec
   result.coverage =
       std::min(1.0, result.num_associated * frame_interval / (gt_span + frame_interval));
   return result;
+}
+
+std::vector<FrameMotionError> EvaluateFrameMotion(const Trajectory& ground_truth,
+                                                  const Trajectory& estimate, double scale,
+                                                  double max_time_diff) {
+  if (!(scale > 0.0) || !std::isfinite(scale)) {
+    throw std::invalid_argument("EvaluateFrameMotion: scale must be positive and finite");
+  }
+  RequireIncreasing(ground_truth, "ground truth");
+  RequireIncreasing(estimate, "estimate");
+  const std::vector<std::pair<int, int>> matches =
+      AssociateByTimestamp(estimate, ground_truth, max_time_diff);
+  constexpr double kDegPerRad = 180.0 / M_PI;
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  std::vector<FrameMotionError> errors;
+  for (size_t m = 1; m < matches.size(); ++m) {
+    const auto [a, gt_a] = matches[m - 1];
+    const auto [b, gt_b] = matches[m];
+    if (b != a + 1) continue;  // an estimate pose between them has no ground truth
+    const SE3 gt_motion =
+        ground_truth[gt_a].world_from_cam.Inverse() * ground_truth[gt_b].world_from_cam;
+    const SE3 est_motion = estimate[a].world_from_cam.Inverse() * estimate[b].world_from_cam;
+    FrameMotionError error;
+    error.timestamp = estimate[b].timestamp;
+    error.rotation_error_deg =
+        kDegPerRad * RotationAngle(gt_motion.rotation().conjugate() * est_motion.rotation());
+    const double gt_length = gt_motion.translation().norm();
+    const double est_length = est_motion.translation().norm();
+    error.translation_direction_error_deg =
+        gt_length > 0.0 && est_length > 0.0
+            ? kDegPerRad *
+                  std::atan2(gt_motion.translation().cross(est_motion.translation()).norm(),
+                             gt_motion.translation().dot(est_motion.translation()))
+            : kNaN;
+    error.translation_ratio = gt_length > 0.0 ? scale * est_length / gt_length : kNaN;
+    errors.push_back(error);
+  }
+  return errors;
+}
+
+void WriteFrameMotionErrorsCsv(const std::vector<FrameMotionError>& errors, std::ostream& out) {
+  const auto number = [&out](double value) -> std::ostream& {
+    return std::isnan(value) ? out << "nan" : out << value;
+  };
+  out << "timestamp,rotation_error_deg,translation_direction_error_deg,translation_ratio\n";
+  out << std::setprecision(9);
+  for (const FrameMotionError& error : errors) {
+    out << error.timestamp << ",";
+    number(error.rotation_error_deg) << ",";
+    number(error.translation_direction_error_deg) << ",";
+    number(error.translation_ratio) << "\n";
+  }
 }
 
 }  // namespace pldvo

@@ -6,6 +6,7 @@
 #define PLDVO_CORE_EVALUATION_H_
 
 #include <Eigen/Core>
+#include <ostream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -92,6 +93,31 @@ std::vector<std::pair<int, int>> AssociateByTimestamp(const Trajectory& estimate
 // timestamps do not increase, or the options are invalid.
 EvaluationResult EvaluateTrajectory(const Trajectory& ground_truth, const Trajectory& estimate,
                                     const EvaluationOptions& options = {});
+
+// The error of one frame-to-frame motion, between consecutive associated estimate poses a and b
+// (docs/evaluation.md, "Per-frame motion errors"). Both motions are a_from_b, in camera a.
+struct FrameMotionError {
+  double timestamp = 0.0;           // of pose b
+  double rotation_error_deg = 0.0;  // angle of R_gt^T R_est
+  // Angle between the estimated and the true translation; NaN when either is zero. Where the
+  // rotation error tracks this angle, the rotation absorbs the translation (bas-relief ambiguity).
+  double translation_direction_error_deg = 0.0;
+  // scale |t_est| / |t_gt| (1: the motion's length agrees at the alignment's scale); NaN when the
+  // ground truth does not move.
+  double translation_ratio = 0.0;
+};
+
+// One entry per pair of consecutive estimate poses that both have a ground-truth pose within
+// max_time_diff (AssociateByTimestamp); `scale` is ground-truth metres per estimate unit (the
+// alignment's, EvaluationResult::scale). Throws std::invalid_argument when the timestamps do not
+// increase or scale is not positive and finite.
+std::vector<FrameMotionError> EvaluateFrameMotion(const Trajectory& ground_truth,
+                                                  const Trajectory& estimate, double scale,
+                                                  double max_time_diff);
+
+// CSV with the header `timestamp,rotation_error_deg,translation_direction_error_deg,
+// translation_ratio` ("nan" for NaN).
+void WriteFrameMotionErrorsCsv(const std::vector<FrameMotionError>& errors, std::ostream& out);
 
 }  // namespace pldvo
 

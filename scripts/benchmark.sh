@@ -96,19 +96,22 @@ awk -F, -v wanted="$wanted" -v repeats="$repeats" -v frames="$frames" '
     v[d SUBSEP c SUBSEP "deg", k] = $col["rpe_deg_s"]
     v[d SUBSEP c SUBSEP "lost", k] = $col["lost_events"]
     v[d SUBSEP c SUBSEP "seg", k] = $col["scale_segments"]
+    v[d SUBSEP c SUBSEP "dir", k] = $col["motion_direction_error_deg_median"]
   }
   END {
-    split("rpe deg lost seg", metrics, " ")
+    split("rpe deg lost seg dir", metrics, " ")
     label["rpe"] = "RPE cm/s"; label["deg"] = "RPE deg/s"
     label["lost"] = "lost events"; label["seg"] = "scale segments"
+    label["dir"] = "motion dir deg"
     fmt["rpe"] = "%.2f"; fmt["deg"] = "%.3f"; fmt["lost"] = "%g"; fmt["seg"] = "%g"
+    fmt["dir"] = "%.1f"
     for (i = 1; i <= nd; ++i) {
       d = order[i]
       printf "\n%s (%s frames, median [min, max] over %d initial maps; ok runs %d / %d sdvo, " \
              "%d / %d points_lines)\n", d, frames, repeats, ok[d, "sdvo"], runs[d, "sdvo"],
              ok[d, "points_lines"], runs[d, "points_lines"]
       printf "  %-15s %-26s %-26s %s\n", "", "sdvo", "points_lines", "pl/sdvo"
-      for (m = 1; m <= 4; ++m) {
+      for (m = 1; m <= 5; ++m) {
         key = metrics[m]
         a = cell(d SUBSEP "sdvo" SUBSEP key, ok[d, "sdvo"], fmt[key])
         b = cell(d SUBSEP "points_lines" SUBSEP key, ok[d, "points_lines"], fmt[key])

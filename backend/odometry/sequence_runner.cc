@@ -15,6 +15,7 @@
 #include <fstream>
 #include <future>
 #include <iomanip>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -346,6 +347,28 @@ std::string AddEvaluation(const Trajectory& ground_truth, const Trajectory& esti
 }
 
 // OUT/trajectory.svg: the estimate, Sim(3)-aligned when there is ground truth, over it.
+// motion_errors.csv and summary.json's medians of its columns (docs/evaluation.md).
+void AddFrameMotionErrors(const Trajectory& ground_truth, const Trajectory& estimate, double scale,
+                          const std::string& out, nlohmann::json* summary) {
+  const std::vector<FrameMotionError> errors =
+      EvaluateFrameMotion(ground_truth, estimate, scale, EvaluationOptions().max_time_diff);
+  std::ofstream file(out + "/motion_errors.csv");
+  WriteFrameMotionErrorsCsv(errors, file);
+  if (!file) throw RunOutputError("cannot write " + out + "/motion_errors.csv");
+  std::vector<double> rotation, direction;
+  for (const FrameMotionError& error : errors) {
+    rotation.push_back(error.rotation_error_deg);
+    if (!std::isnan(error.translation_direction_error_deg)) {
+      direction.push_back(error.translation_direction_error_deg);
+    }
+  }
+  const auto median_or_nan = [](const std::vector<double>& values) {
+    return values.empty() ? std::numeric_limits<double>::quiet_NaN() : Median(values);
+  };
+  (*summary)["motion_rotation_error_deg_median"] = NumberOrNull(median_or_nan(rotation));
+  (*summary)["motion_direction_error_deg_median"] = NumberOrNull(median_or_nan(direction));
+}
+
 void WriteRunSvg(const std::string& path, const std::string& title, const Trajectory* ground_truth,
                  const Trajectory& estimate, const Sim3Alignment* gt_from_est) {
   std::vector<Eigen::Vector3d> gt_positions;
@@ -589,6 +612,7 @@ SequenceRunResult SequenceRunner::Run() {
     const std::string line = AddEvaluation(*ground_truth, estimate, &summary, &gt_from_est);
     aligned = !summary.contains("evaluation_error");
     result.report.push_back("  " + line);
+    if (aligned) AddFrameMotionErrors(*ground_truth, estimate, gt_from_est.scale, out, &summary);
   }
   if (comparison != nullptr) {
     summary["compare_solver"] = comparison->Summary(ground_truth);

@@ -1,10 +1,12 @@
-// `pldvo eval --gt FILE --est FILE [--json]`: ATE, RPE, coverage and scale drift of an estimated
-// trajectory against ground truth, both in TUM format (docs/evaluation.md). `--set key=value`
-// sets the EvaluationOptions (max_time_diff, rpe_delta, align_scale, scale_window).
+// `pldvo eval --gt FILE --est FILE [--json] [--motion_errors CSV]`: ATE, RPE, coverage and scale
+// drift of an estimated trajectory against ground truth, both in TUM format (docs/evaluation.md).
+// `--set key=value` sets the EvaluationOptions (max_time_diff, rpe_delta, align_scale,
+// scale_window).
 #include <gflags/gflags.h>
 
 #include <cmath>
 #include <exception>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -17,6 +19,9 @@
 DEFINE_string(gt, "", "Ground-truth trajectory, TUM format (timestamp tx ty tz qx qy qz qw).");
 DEFINE_string(est, "", "Estimated trajectory, TUM format.");
 DEFINE_bool(json, false, "Print one JSON object instead of the text summary.");
+DEFINE_string(motion_errors, "",
+              "Also write the error of every frame-to-frame motion to this CSV "
+              "(docs/evaluation.md, \"Per-frame motion errors\").");
 
 namespace pldvo {
 namespace {
@@ -38,6 +43,12 @@ int RunEval(const CommandContext& context) {
     const Trajectory ground_truth = ReadTrajectoryTum(FLAGS_gt);
     const Trajectory estimate = ReadTrajectoryTum(FLAGS_est);
     const EvaluationResult result = EvaluateTrajectory(ground_truth, estimate, options);
+    if (!FLAGS_motion_errors.empty()) {
+      std::ofstream file(FLAGS_motion_errors);
+      WriteFrameMotionErrorsCsv(
+          EvaluateFrameMotion(ground_truth, estimate, result.scale, options.max_time_diff), file);
+      if (!file) throw std::runtime_error("cannot write " + FLAGS_motion_errors);
+    }
     if (FLAGS_json) {
       nlohmann::json json;
       json["ate_m"] = result.ate_m;

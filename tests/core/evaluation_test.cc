@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <sstream>
 
 #include "core/random_draws.h"
 
@@ -243,6 +244,72 @@ TEST(EvaluateTrajectory, ShortEstimateHasNoRpePairs) {
   const EvaluationResult result = EvaluateTrajectory(gt, gt);
   EXPECT_EQ(result.num_pairs, 0);
   EXPECT_TRUE(std::isnan(result.rpe_cm_s));
+}
+
+TEST(EvaluateFrameMotion, AYawOfOneFrameShowsInTheTwoMotionsAroundIt) {
+  // gt: 0.1 m per frame along x, camera orientation identity. est: the same path at half scale
+  // (scale 2), but pose 2 yawed by theta. Motion 1 -> 2: rotation error theta, translation along
+  // x in camera 1 for both (direction 0, ratio 2 * 0.05 / 0.1 = 1). Motion 2 -> 3: rotation error
+  // theta, est translation Rz(-theta) (0.05, 0, 0) in camera 2: direction error theta. Motions
+  // 0 -> 1 and 3 -> 4 are exact.
+  const double theta = 2.0 * M_PI / 180.0;
+  const Eigen::Quaterniond yaw(Eigen::AngleAxisd(theta, Eigen::Vector3d::UnitZ()));
+  Trajectory gt, est;
+  for (int i = 0; i < 5; ++i) {
+    gt.push_back(Pose(0.1 * i, Eigen::Vector3d(0.1 * i, 0, 0)));
+    est.push_back(Pose(0.1 * i, Eigen::Vector3d(0.05 * i, 0, 0),
+                       i == 2 ? yaw : Eigen::Quaterniond::Identity()));
+  }
+  const std::vector<FrameMotionError> errors = EvaluateFrameMotion(gt, est, 2.0, 0.02);
+  ASSERT_EQ(errors.size(), 4u);
+  const double expected_rotation[] = {0.0, 2.0, 2.0, 0.0};
+  const double expected_direction[] = {0.0, 0.0, 2.0, 0.0};
+  for (int m = 0; m < 4; ++m) {
+    SCOPED_TRACE(m);
+    EXPECT_NEAR(errors[m].timestamp, 0.1 * (m + 1), kTolerance);
+    EXPECT_NEAR(errors[m].rotation_error_deg, expected_rotation[m], kTolerance);
+    EXPECT_NEAR(errors[m].translation_direction_error_deg, expected_direction[m], 1e-6);
+    EXPECT_NEAR(errors[m].translation_ratio, 1.0, kTolerance);
+  }
+}
+
+TEST(EvaluateFrameMotion, ReportsTheAngleBetweenTranslationsAndSkipsPosesWithoutGroundTruth) {
+  // gt moves along x, then stands still; est moves along y (90 deg off), then forward-backward
+  // (180 deg). The estimate pose at t = 0.15 has no ground truth: the motions 0.1 -> 0.15 and
+  // 0.15 -> 0.2 are left out, not bridged.
+  Trajectory gt, est;
+  for (int i = 0; i < 5; ++i)
+    gt.push_back(Pose(0.1 * i, Eigen::Vector3d(std::min(i, 3), 0.0, 0.0)));
+  est.push_back(Pose(0.0, Eigen::Vector3d(0, 0, 0)));
+  est.push_back(Pose(0.1, Eigen::Vector3d(0, 1, 0)));
+  est.push_back(Pose(0.15, Eigen::Vector3d(0, 1.5, 0)));
+  est.push_back(Pose(0.2, Eigen::Vector3d(0, 2, 0)));
+  est.push_back(Pose(0.3, Eigen::Vector3d(0, 3, 0)));
+  est.push_back(Pose(0.4, Eigen::Vector3d(0, 3, 0)));
+  const std::vector<FrameMotionError> errors = EvaluateFrameMotion(gt, est, 0.5, 0.02);
+  ASSERT_EQ(errors.size(), 3u);
+  EXPECT_NEAR(errors[0].timestamp, 0.1, kTolerance);
+  EXPECT_NEAR(errors[0].translation_direction_error_deg, 90.0, kTolerance);
+  EXPECT_NEAR(errors[0].translation_ratio, 0.5, kTolerance);
+  EXPECT_NEAR(errors[1].timestamp, 0.3, kTolerance);
+  EXPECT_NEAR(errors[1].translation_direction_error_deg, 90.0, kTolerance);
+  // gt stands still from 0.3 to 0.4 and so does est: neither a direction nor a ratio.
+  EXPECT_TRUE(std::isnan(errors[2].translation_direction_error_deg));
+  EXPECT_TRUE(std::isnan(errors[2].translation_ratio));
+  EXPECT_NEAR(errors[2].rotation_error_deg, 0.0, kTolerance);
+
+  std::ostringstream csv;
+  WriteFrameMotionErrorsCsv(errors, csv);
+  EXPECT_EQ(csv.str().substr(0, csv.str().find('\n')),
+            "timestamp,rotation_error_deg,translation_direction_error_deg,translation_ratio");
+  EXPECT_NE(csv.str().find("0.4,0,nan,nan\n"), std::string::npos) << csv.str();
+}
+
+TEST(EvaluateFrameMotion, RejectsABadScale) {
+  const Trajectory trajectory = CurvedTrajectory(5);
+  EXPECT_THROW(EvaluateFrameMotion(trajectory, trajectory, 0.0, 0.02), std::invalid_argument);
+  EXPECT_THROW(EvaluateFrameMotion(trajectory, trajectory, std::nan(""), 0.02),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -124,8 +124,16 @@ TEST(RunCommandTest, WritesAllOutputs) {
       EXPECT_GE(summary[object][key].get<double>(), 0.0);
     }
   }
-  for (const char* key : {"rpe_cm_s", "rpe_deg_s", "ate_m", "coverage", "scale_drift"}) {
+  for (const char* key :
+       {"rpe_cm_s", "rpe_deg_s", "ate_m", "coverage", "scale_drift",
+        "motion_rotation_error_deg_median", "motion_direction_error_deg_median"}) {
     EXPECT_TRUE(summary[key].is_number()) << key;
+  }
+  // motion_errors.csv: a header and one row per motion between consecutive tracked frames.
+  EXPECT_EQ(CountLines(out / "motion_errors.csv", false), kFrames);
+  for (const std::vector<std::string>& row : CsvRows(out / "motion_errors.csv")) {
+    ASSERT_EQ(row.size(), 4u);
+    EXPECT_GE(std::stod(row[1]), 0.0);
   }
   ASSERT_TRUE(summary["window_scales"].is_array());
   EXPECT_FALSE(summary["window_scales"].empty());
@@ -416,16 +424,18 @@ TEST(AblateCommandTest, TinyGridWritesTablesAndPlot) {
                       0),
             0u)
       << csv;
-  // The scale segments close the header (appended: scripts read the columns by position), and
-  // neither run of this short sequence re-initialises.
-  EXPECT_NE(csv.find(",dir,scale_segments\n"), std::string::npos) << csv;
-  EXPECT_NE(csv.find("/lowtex__sdvo,1\n"), std::string::npos) << csv;
+  // The scale segments and the motion direction error close the header (appended: scripts read
+  // the columns by position), and neither run of this short sequence re-initialises.
+  EXPECT_NE(csv.find(",dir,scale_segments,motion_direction_error_deg_median\n"), std::string::npos)
+      << csv;
+  EXPECT_NE(csv.find("/lowtex__sdvo,1,"), std::string::npos) << csv;
   // results.md: the RPE table with one row for the sequence and a column per config.
   const std::string md = Slurp(out / "results.md");
   EXPECT_NE(md.find("| sequence | sdvo | points_lines |"), std::string::npos) << md;
   EXPECT_NE(md.find("| lowtex |"), std::string::npos) << md;
   EXPECT_NE(md.find("### Scale drift"), std::string::npos) << md;
   EXPECT_NE(md.find("### Scale segments"), std::string::npos) << md;
+  EXPECT_NE(md.find("### Translation direction error"), std::string::npos) << md;
   // Inline mapping runs on the tracking thread, and the timing table says so.
   EXPECT_NE(md.find("### Median tracking-thread time per frame (ms; mapping inline, included)"),
             std::string::npos)
@@ -524,12 +534,13 @@ TEST(AblateCommandTest, ShardsThenCollectGiveTheResultsOfOneRun) {
   ASSERT_EQ(expected.size(), num_runs);
   ASSERT_EQ(actual.size(), expected.size());
   // Columns: ..., 12 ms_median_tracking_thread, 13 ms_median_total, 14 init_seed, 15 dir,
-  // 16 scale_segments: all but the times and the run folder must agree.
+  // 16 scale_segments, 17 motion_direction_error_deg_median: all but the times and the run folder
+  // must agree.
   for (size_t row = 0; row < expected.size(); ++row) {
-    ASSERT_EQ(actual[row].size(), 17u);
-    ASSERT_EQ(expected[row].size(), 17u);
+    ASSERT_EQ(actual[row].size(), 18u);
+    ASSERT_EQ(expected[row].size(), 18u);
     EXPECT_EQ(expected[row][2], "ok") << "row " << row;
-    for (size_t column = 0; column < 17; ++column) {
+    for (size_t column = 0; column < 18; ++column) {
       if (column == 12 || column == 13 || column == 15) continue;
       EXPECT_EQ(actual[row][column], expected[row][column])
           << "row " << row << " column " << column;
