@@ -24,6 +24,33 @@ double RotationAngle(const Eigen::Quaterniond& q) {
   return 2.0 * std::atan2(q.vec().norm(), std::abs(q.w()));
 }
 
+// The pose at time t: the pose stamped t (within 1 us), or the interpolation (translation linear,
+// rotation slerp) between the poses just before and after t when they are at most max_gap apart.
+bool InterpolatePose(const Trajectory& trajectory, double t, double max_gap, SE3* pose) {
+  const auto it =
+      std::lower_bound(trajectory.begin(), trajectory.end(), t,
+                       [](const StampedPose& p, double value) { return p.timestamp < value; });
+  constexpr double kSameTime = 1e-6;  // s: stamps that differ by the text round trip only
+  const size_t after_index = static_cast<size_t>(it - trajectory.begin());
+  for (size_t i = after_index == 0 ? 0 : after_index - 1; i <= after_index && i < trajectory.size();
+       ++i) {
+    if (std::abs(trajectory[i].timestamp - t) <= kSameTime) {
+      *pose = trajectory[i].world_from_cam;
+      return true;
+    }
+  }
+  if (it == trajectory.begin() || it == trajectory.end()) return false;
+  const StampedPose& before = *(it - 1);
+  const StampedPose& after = *it;
+  const double gap = after.timestamp - before.timestamp;
+  if (gap > max_gap) return false;
+  const double f = (t - before.timestamp) / gap;
+  *pose =
+      SE3(before.world_from_cam.rotation().slerp(f, after.world_from_cam.rotation()),
+          (1.0 - f) * before.world_from_cam.translation() + f * after.world_from_cam.translation());
+  return true;
+}
+
 int NearestPose(const Trajectory& trajectory, double t) {
   const auto it = std::lower_bound(
       trajectory.begin(), trajectory.end(), t,
@@ -209,17 +236,19 @@ std::vector<FrameMotionError> EvaluateFrameMotion(const Trajectory& ground_truth
   }
   RequireIncreasing(ground_truth, "ground truth");
   RequireIncreasing(estimate, "estimate");
-  const std::vector<std::pair<int, int>> matches =
-      AssociateByTimestamp(estimate, ground_truth, max_time_diff);
+  // The ground truth at each estimate pose's timestamp (interpolated, see InterpolatePose).
+  std::vector<SE3> gt_at(estimate.size());
+  std::vector<char> have(estimate.size(), 0);
+  for (size_t i = 0; i < estimate.size(); ++i) {
+    have[i] = InterpolatePose(ground_truth, estimate[i].timestamp, 2.0 * max_time_diff, &gt_at[i]);
+  }
   constexpr double kDegPerRad = 180.0 / M_PI;
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   std::vector<FrameMotionError> errors;
-  for (size_t m = 1; m < matches.size(); ++m) {
-    const auto [a, gt_a] = matches[m - 1];
-    const auto [b, gt_b] = matches[m];
-    if (b != a + 1) continue;  // an estimate pose between them has no ground truth
-    const SE3 gt_motion =
-        ground_truth[gt_a].world_from_cam.Inverse() * ground_truth[gt_b].world_from_cam;
+  for (size_t b = 1; b < estimate.size(); ++b) {
+    const size_t a = b - 1;
+    if (!have[a] || !have[b]) continue;
+    const SE3 gt_motion = gt_at[a].Inverse() * gt_at[b];
     const SE3 est_motion = estimate[a].world_from_cam.Inverse() * estimate[b].world_from_cam;
     FrameMotionError error;
     error.timestamp = estimate[b].timestamp;
