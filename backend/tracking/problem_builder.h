@@ -48,6 +48,14 @@ struct ProblemBuilderOptions {
   BrightnessModel brightness = BrightnessModel::kNone;
   double brightness_prior_sigma_a = 0.1;
   double brightness_prior_sigma_b = 10.0;
+  // The photometric rows of one keyframe edge (reference points with one edge id) count as at
+  // most this many points: an edge with n > max_rows_per_edge rows at a level has each row's
+  // weight scaled by sqrt(max_rows_per_edge / n), so its total information is that of
+  // max_rows_per_edge points. The points of an edge share its errors (a depth wrong along the
+  // whole edge, an occluding edge that splits): hundreds of coherent rows otherwise outvote the
+  // rest of the view through a row-wise robust loss (docs/tracking.md, "Rows per edge"). 0: off
+  // (paper.yaml); 50 measured as 20 on the development set (both 0.85x the RPE without).
+  double max_rows_per_edge = 50.0;
   WeightingOptions weighting;
 
   template <class Visitor>
@@ -63,6 +71,9 @@ struct ProblemBuilderOptions {
             "Standard deviation of the zero-mean prior on the log-gain a (affine).");
     v.Field("brightness_prior_sigma_b", &brightness_prior_sigma_b,
             "Standard deviation of the zero-mean prior on the bias b, gray levels (affine).");
+    v.Field("max_rows_per_edge", &max_rows_per_edge,
+            "Photometric rows of one keyframe edge count as at most this many points (each "
+            "row's weight scaled by sqrt(cap / n)); 0 = off (default 50).");
     v.Section("weighting", &weighting, "Weighting of the residual families and robust loss.");
   }
   std::string Check() const;

@@ -32,8 +32,25 @@ const MatchedLine* MatchedLineOf(const TrackingReferenceLevel& ref, const Refere
 
 }  // namespace
 
+std::vector<double> EdgeRowScales(const TrackingReferenceLevel& ref, double max_rows_per_edge) {
+  if (!(max_rows_per_edge > 0.0)) return {};
+  std::vector<double> scale;
+  for (const ReferencePoint& point : ref.points) {
+    if (point.edge_id < 0) continue;
+    if (point.edge_id >= static_cast<int>(scale.size())) scale.resize(point.edge_id + 1, 0.0);
+    scale[point.edge_id] += 1.0;  // the count, for now
+  }
+  for (double& value : scale) {
+    value = value > max_rows_per_edge ? std::sqrt(max_rows_per_edge / value) : 1.0;
+  }
+  return scale;
+}
+
 std::string ProblemBuilderOptions::Check() const {
   if (batch_size < 1) return "batch_size must be >= 1";
+  if (!(max_rows_per_edge >= 0.0) || !std::isfinite(max_rows_per_edge)) {
+    return "max_rows_per_edge must be >= 0 and finite";
+  }
   if (!(brightness_prior_sigma_a > 0.0) || !(brightness_prior_sigma_b > 0.0) ||
       !std::isfinite(brightness_prior_sigma_a) || !std::isfinite(brightness_prior_sigma_b)) {
     return "brightness_prior_sigma_a and brightness_prior_sigma_b must be positive and finite";
@@ -126,6 +143,8 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
   ceres::LossFunction* loss_outside = loss_in_problem_ ? loss : nullptr;
   const size_t batch = loss_in_problem_ ? 1 : static_cast<size_t>(options_.batch_size);
 
+  const std::vector<double> edge_row_scale = EdgeRowScales(ref, options_.max_rows_per_edge);
+
   BuildStatistics stats;
   if (UsesPhotometric(weighting.policy)) {
     std::vector<PhotometricObservation> observations;
@@ -142,9 +161,12 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
       observations.reserve(batch);
     };
     for (const ReferencePoint& point : ref.points) {
-      const double sqrt_info = PhotometricSqrtInfo(weighting, camera, current, level, pose,
-                                                   point.pixel, point.idepth, point.idepth_var);
+      double sqrt_info = PhotometricSqrtInfo(weighting, camera, current, level, pose, point.pixel,
+                                             point.idepth, point.idepth_var);
       if (!(sqrt_info > 0.0)) continue;
+      if (point.edge_id >= 0 && point.edge_id < static_cast<int>(edge_row_scale.size())) {
+        sqrt_info *= edge_row_scale[point.edge_id];
+      }
       PhotometricObservation observation;
       observation.pixel_in_ref = point.pixel;
       observation.idepth = point.idepth;

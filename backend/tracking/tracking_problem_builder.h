@@ -21,13 +21,22 @@
 // `loss_in_problem` (registry name "tracking_ceres_loss") every row is its own block and the
 // robust loss is passed with it as a ceres::LossFunction instead. With line_error_model
 // shared_per_edge (builder "tracking" only) the point-to-line rows form one block per edge,
-// whitened against the line error its pixels share.
+// whitened against the line error its pixels share. With max_rows_per_edge > 0 the photometric
+// rows of an edge with more points than that are down-weighted (EdgeRowScales).
 #ifndef PLDVO_BACKEND_TRACKING_TRACKING_PROBLEM_BUILDER_H_
 #define PLDVO_BACKEND_TRACKING_TRACKING_PROBLEM_BUILDER_H_
+
+#include <vector>
 
 #include "backend/tracking/problem_builder.h"
 
 namespace pldvo {
+
+// Per edge id of the level's points, the factor on its photometric rows' sqrt_info:
+// sqrt(max_rows_per_edge / n) for an edge with n > max_rows_per_edge points, else 1 (the rows of
+// an edge then carry at most max_rows_per_edge points' information). Empty when
+// max_rows_per_edge is 0 (off).
+std::vector<double> EdgeRowScales(const TrackingReferenceLevel& ref, double max_rows_per_edge);
 
 class TrackingProblemBuilder : public ProblemBuilder {
  public:

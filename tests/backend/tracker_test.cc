@@ -19,6 +19,7 @@
 #include "backend/optimization/solver.h"
 #include "backend/tracking/photometric_consensus.h"
 #include "backend/tracking/problem_builder.h"
+#include "backend/tracking/tracking_problem_builder.h"
 #include "backend/tracking/tracking_reference.h"
 #include "core/statistics.h"
 #include "experiments/evaluation/synthetic_pairs.h"
@@ -150,6 +151,68 @@ TEST(ProblemBuilderTest, PoliciesSelectResidualFamiliesAndBatching) {
             stats[WeightingPolicy::kPhotometricOnly].photometric_residuals);
   EXPECT_EQ(stats[WeightingPolicy::kCovariance].line_residuals,
             stats[WeightingPolicy::kLineOnly].line_residuals);
+}
+
+TEST(ProblemBuilderTest, MaxRowsPerEdgeCapsTheInformationOfEachEdge) {
+  const FramePair& pair = Pair("lowtex");
+  const TrackingReference reference =
+      MakePairReference(pair, GroundTruthReferenceOptions(), /*with_edges=*/true);
+  const ImagePyramid current(pair.cur_image, 4);
+  const TrackingReferenceLevel& level0 = reference.levels[0];
+  constexpr double kCap = 20.0;
+  std::vector<int> count;
+  for (const ReferencePoint& point : level0.points) {
+    if (point.edge_id < 0) continue;
+    if (point.edge_id >= static_cast<int>(count.size())) count.resize(point.edge_id + 1, 0);
+    ++count[point.edge_id];
+  }
+  // An edge of n > cap points: each row's weight times sqrt(cap / n), n s^2 = cap.
+  EXPECT_TRUE(EdgeRowScales(level0, 0.0).empty());
+  const std::vector<double> scale = EdgeRowScales(level0, kCap);
+  ASSERT_EQ(scale.size(), count.size());
+  int longest = -1;
+  for (size_t e = 0; e < count.size(); ++e) {
+    if (count[e] > kCap) {
+      EXPECT_NEAR(count[e] * scale[e] * scale[e], kCap, 1e-9) << "edge " << e;
+    } else {
+      EXPECT_EQ(scale[e], 1.0) << "edge " << e;
+    }
+    if (longest < 0 || count[e] > count[longest]) longest = static_cast<int>(e);
+  }
+  ASSERT_GT(count[longest], 2 * kCap);
+
+  // The problem of one level: without a robust loss the cost of an edge's rows scales by
+  // cap / n, the cost of points on no edge does not change.
+  const auto cost = [&](const std::vector<ReferencePoint>& points, double cap) {
+    TrackingReference only = reference;
+    only.levels.resize(1);
+    only.levels[0].points = points;
+    ProblemBuilderOptions options;
+    options.weighting.policy = WeightingPolicy::kPhotometricOnly;
+    options.weighting.robust_loss = RobustLossKind::kNone;
+    options.max_rows_per_edge = cap;
+    double pose[7];
+    PoseToParameters(
+        SE3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.01, 0, 0)) * pair.cur_from_ref, pose);
+    LeastSquaresProblem problem;
+    MakeProblemBuilder("tracking", options)->Build(only, current, 0, pose, nullptr, &problem);
+    double value = 0.0;
+    EXPECT_TRUE(problem.EvaluateCost(&value));
+    return value;
+  };
+  std::vector<ReferencePoint> on_longest, on_no_edge;
+  for (const ReferencePoint& point : level0.points) {
+    if (point.edge_id == longest) on_longest.push_back(point);
+    if (point.edge_id < 0) on_no_edge.push_back(point);
+  }
+  const double uncapped = cost(on_longest, 0.0);
+  ASSERT_GT(uncapped, 0.0);
+  EXPECT_NEAR(cost(on_longest, kCap) / uncapped, kCap / count[longest], 1e-9);
+  if (!on_no_edge.empty()) EXPECT_EQ(cost(on_no_edge, kCap), cost(on_no_edge, 0.0));
+
+  ProblemBuilderOptions bad;
+  bad.max_rows_per_edge = -1.0;
+  EXPECT_THROW(MakeProblemBuilder("tracking", bad), std::invalid_argument);
 }
 
 // Replaces the Jacobian of a pose cost function (not owned) by central differences in the

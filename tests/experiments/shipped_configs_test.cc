@@ -68,6 +68,7 @@ void ExpectExtras(const OdometryConfig& config, bool on, const std::string& name
   EXPECT_EQ(config.tracking.problem.weighting.intensity_noise,
             on ? IntensityNoiseSource::kEstimated : IntensityNoiseSource::kFixed);
   EXPECT_EQ(config.keyframes.max_rms_growth, on ? 1.5 : 0.0);
+  EXPECT_EQ(config.tracking.problem.max_rows_per_edge, on ? 50.0 : 0.0);
 }
 
 // Per shipped file: what its header comment says it turns on.
