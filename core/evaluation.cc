@@ -31,15 +31,16 @@ bool InterpolatePose(const Trajectory& trajectory, double t, double max_gap, SE3
       std::lower_bound(trajectory.begin(), trajectory.end(), t,
                        [](const StampedPose& p, double value) { return p.timestamp < value; });
   constexpr double kSameTime = 1e-6;  // s: stamps that differ by the text round trip only
-  const size_t after_index = static_cast<size_t>(it - trajectory.begin());
-  for (size_t i = after_index == 0 ? 0 : after_index - 1; i <= after_index && i < trajectory.size();
-       ++i) {
-    if (std::abs(trajectory[i].timestamp - t) <= kSameTime) {
-      *pose = trajectory[i].world_from_cam;
-      return true;
-    }
+  if (it != trajectory.end() && it->timestamp - t <= kSameTime) {
+    *pose = it->world_from_cam;
+    return true;
   }
-  if (it == trajectory.begin() || it == trajectory.end()) return false;
+  if (it == trajectory.begin()) return false;
+  if (t - (it - 1)->timestamp <= kSameTime) {
+    *pose = (it - 1)->world_from_cam;
+    return true;
+  }
+  if (it == trajectory.end()) return false;
   const StampedPose& before = *(it - 1);
   const StampedPose& after = *it;
   const double gap = after.timestamp - before.timestamp;

@@ -346,7 +346,6 @@ std::string AddEvaluation(const Trajectory& ground_truth, const Trajectory& esti
   }
 }
 
-// OUT/trajectory.svg: the estimate, Sim(3)-aligned when there is ground truth, over it.
 // motion_errors.csv and summary.json's medians of its columns (docs/evaluation.md).
 void AddFrameMotionErrors(const Trajectory& ground_truth, const Trajectory& estimate, double scale,
                           const std::string& out, nlohmann::json* summary) {
@@ -369,6 +368,7 @@ void AddFrameMotionErrors(const Trajectory& ground_truth, const Trajectory& esti
   (*summary)["motion_direction_error_deg_median"] = NumberOrNull(median_or_nan(direction));
 }
 
+// OUT/trajectory.svg: the estimate, Sim(3)-aligned when there is ground truth, over it.
 void WriteRunSvg(const std::string& path, const std::string& title, const Trajectory* ground_truth,
                  const Trajectory& estimate, const Sim3Alignment* gt_from_est) {
   std::vector<Eigen::Vector3d> gt_positions;
