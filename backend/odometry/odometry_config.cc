@@ -51,6 +51,14 @@ std::string OdometryOptions::Check() const {
   }
   if (two_view_min_inliers < 8) return "two_view_min_inliers must be >= 8";
   if (two_view_max_frames < 1) return "two_view_max_frames must be >= 1";
+  if (!(two_view_corner_quality > 0.0 && two_view_corner_quality < 1.0)) {
+    return "two_view_corner_quality must be in (0, 1)";
+  }
+  if (!(two_view_corner_min_distance_px >= 0.0)) {
+    return "two_view_corner_min_distance_px must be >= 0";
+  }
+  if (!(two_view_max_direction_std_deg > 0.0)) return "two_view_max_direction_std_deg must be > 0";
+  if (two_view_stable_frames < 1) return "two_view_stable_frames must be >= 1";
   return "";
 }
 

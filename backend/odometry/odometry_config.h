@@ -181,6 +181,13 @@ struct OdometryOptions {
   double two_view_min_rotation_free_parallax_px = 3.0;
   int two_view_min_inliers = 50;
   int two_view_max_frames = 60;
+  // Its corners: cv::goodFeaturesToTrack's quality (relative to the strongest corner) and spacing;
+  // the second view's adjusted translation direction: its largest standard deviation, and how
+  // many consecutive frames' directions must agree to within that.
+  double two_view_corner_quality = 0.001;
+  double two_view_corner_min_distance_px = 5.0;
+  double two_view_max_direction_std_deg = 3.0;
+  int two_view_stable_frames = 3;
   // Solver comparison (docs/tracking.md): every tracked frame's final tracking problem (the same
   // reference, lines and initial pose) is solved a second time with this solver; its poses, RPE
   // and time are reported beside the run's (summary.json `compare_solver`,
@@ -263,6 +270,19 @@ struct OdometryOptions {
             "Two-view bootstrap: triangulated essential-matrix inliers needed (default 50).");
     v.Field("two_view_max_frames", &two_view_max_frames,
             "Two-view bootstrap: frames searched for the second view (default 60).");
+    v.Field("two_view_corner_quality", &two_view_corner_quality,
+            "Two-view bootstrap: smallest corner response relative to frame 0's strongest "
+            "(cv::goodFeaturesToTrack qualityLevel, default 0.001).");
+    v.Field("two_view_corner_min_distance_px", &two_view_corner_min_distance_px,
+            "Two-view bootstrap: smallest distance between corners, px (default 5).");
+    v.Field("two_view_max_direction_std_deg", &two_view_max_direction_std_deg,
+            "Two-view bootstrap: largest standard deviation of the second view's translation "
+            "direction after the bundle adjustment (1 px noise), deg; else the next frame is "
+            "tried (default 3).");
+    v.Field("two_view_stable_frames", &two_view_stable_frames,
+            "Two-view bootstrap: consecutive frames passing the gates whose adjusted translation "
+            "directions must agree to within two_view_max_direction_std_deg; the last is the "
+            "second view (1 = no check, default 3).");
     v.Choice("compare_solver", &compare_solver,
              ChoiceNames<CompareSolver>{{"none", CompareSolver::kNone},
                                         {"ceres", CompareSolver::kCeres},

@@ -1,15 +1,19 @@
 #include "backend/odometry/two_view_bootstrap.h"
 
 #include <ceres/autodiff_cost_function.h>
+#include <ceres/covariance.h>
 #include <ceres/loss_function.h>
 #include <ceres/manifold.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <deque>
+#include <limits>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
@@ -28,8 +32,6 @@ namespace {
 
 // Corner detection and tracking (OpenCV's defaults where it has them).
 constexpr int kMaxCorners = 1000;
-constexpr double kCornerQuality = 0.01;
-constexpr double kCornerMinDistancePx = 7.0;
 constexpr int kLkWindowPx = 21;
 constexpr int kLkLevels = 3;
 // A track survives a frame when tracking back lands within this of where it started.
@@ -40,6 +42,10 @@ constexpr double kRansacThresholdPx = 1.0;
 // Bundle adjustment: Huber scale of the reprojection error and iteration cap.
 constexpr double kHuberPx = 1.0;
 constexpr int kMaxBundleIterations = 50;
+// The adjustment that tests a second view (at every frame that passes the parallax gates) takes
+// at most this many corners and frames, evenly spread: its cost grows with their product.
+constexpr int kMaxTestCorners = 200;
+constexpr int kMaxTestFrames = 8;
 
 cv::Mat ToGray8(const cv::Mat& image) {
   cv::Mat gray;
@@ -142,33 +148,37 @@ struct ReprojectionError {
   cv::Matx33d K;
 };
 
-// Bundle adjustment of the poses of frames 1..k (frame 0 fixed at the identity) and of the
-// triangulated corners over all their observations in frames 0..k. Gauge: frame 0 fixed and
-// frame k's translation on a sphere (SphereManifold keeps its norm). Poses start interpolated
-// between frame 0 and the two-view pose of frame k (slerp / linear in the frame index).
-void BundleAdjust(const std::vector<Track>& tracks, const std::vector<int>& track_ids,
-                  const cv::Matx33d& K, std::vector<Eigen::Quaterniond>* rotations,
-                  std::vector<Eigen::Vector3d>* translations,
-                  std::vector<Eigen::Vector3d>* points) {
-  const int k = static_cast<int>(rotations->size()) - 1;
+// Bundle adjustment of the poses of `frames` (ascending, from 0 to k; frame 0 fixed at the
+// identity) and of the corners `track_ids` over all their observations in those frames; pose j
+// is that of frames[j]. Gauge: frame 0 fixed and frame k's translation on a sphere
+// (SphereManifold keeps its norm). With `direction_std`, returns the standard deviation of frame
+// k's translation direction, deg: the larger of the two in the sphere's tangent plane, from the
+// covariance at the solution for 1 px reprojection noise (infinite when the covariance is
+// rank-deficient); else 0.
+double BundleAdjust(const std::vector<Track>& tracks, const std::vector<int>& track_ids,
+                    const std::vector<int>& frames, const cv::Matx33d& K,
+                    std::vector<Eigen::Quaterniond>* rotations,
+                    std::vector<Eigen::Vector3d>* translations,
+                    std::vector<Eigen::Vector3d>* points, bool direction_std) {
+  const int last = static_cast<int>(frames.size()) - 1;
   ceres::HuberLoss loss(kHuberPx);  // one for every residual block
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
-  for (int j = 0; j <= k; ++j) {
+  for (int j = 0; j <= last; ++j) {
     problem.AddParameterBlock((*rotations)[j].coeffs().data(), 4,
                               new ceres::EigenQuaternionManifold());
     problem.AddParameterBlock((*translations)[j].data(), 3);
   }
   problem.SetParameterBlockConstant((*rotations)[0].coeffs().data());
   problem.SetParameterBlockConstant((*translations)[0].data());
-  problem.SetManifold((*translations)[k].data(), new ceres::SphereManifold<3>());
+  problem.SetManifold((*translations)[last].data(), new ceres::SphereManifold<3>());
   for (size_t i = 0; i < track_ids.size(); ++i) {
-    for (int j = 0; j <= k; ++j) {
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ReprojectionError, 2, 4, 3, 3>(
-                                   new ReprojectionError(tracks[track_ids[i]].positions[j], K)),
-                               &loss, (*rotations)[j].coeffs().data(), (*translations)[j].data(),
-                               (*points)[i].data());
+    for (int j = 0; j <= last; ++j) {
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<ReprojectionError, 2, 4, 3, 3>(
+              new ReprojectionError(tracks[track_ids[i]].positions[frames[j]], K)),
+          &loss, (*rotations)[j].coeffs().data(), (*translations)[j].data(), (*points)[i].data());
     }
   }
   ceres::Solver::Options options;
@@ -178,6 +188,49 @@ void BundleAdjust(const std::vector<Track>& tracks, const std::vector<int>& trac
   options.num_threads = 1;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
+  if (!direction_std) return 0.0;
+
+  ceres::Covariance::Options covariance_options;
+  covariance_options.algorithm_type = ceres::SPARSE_QR;
+  ceres::Covariance covariance(covariance_options);
+  const std::vector<const double*> blocks{(*translations)[last].data()};
+  Eigen::Matrix2d tangent_covariance;  // row-major and column-major alike (symmetric)
+  if (!covariance.Compute(blocks, &problem) ||
+      !covariance.GetCovarianceMatrixInTangentSpace(blocks, tangent_covariance.data())) {
+    return std::numeric_limits<double>::infinity();
+  }
+  // |t_k| = 1: a tangent step of s turns the direction by s radians.
+  const double largest_variance =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(tangent_covariance).eigenvalues()(1);
+  return std::sqrt(std::max(largest_variance, 0.0)) * 180.0 / M_PI;
+}
+
+// The poses (cam_from_ref) of `frames` interpolated between the identity (frame 0) and the
+// two-view pose of the last frame k (slerp / linear in frame / k), the bundle adjustment's start.
+void InterpolatePoses(const TwoViewGeometry& geometry, const std::vector<int>& frames,
+                      std::vector<Eigen::Quaterniond>* rotations,
+                      std::vector<Eigen::Vector3d>* translations) {
+  const Eigen::Quaterniond rotation_k(geometry.rotation);
+  rotations->clear();
+  translations->clear();
+  for (int frame : frames) {
+    const double f = static_cast<double>(frame) / frames.back();
+    rotations->push_back(Eigen::Quaterniond::Identity().slerp(f, rotation_k));
+    translations->push_back(f * geometry.translation);
+  }
+}
+
+// At most `count` of 0..size - 1, evenly spaced, the first and the last among them.
+std::vector<int> EvenlySpaced(int size, int count) {
+  if (size <= count) {
+    std::vector<int> all(size);
+    for (int i = 0; i < size; ++i) all[i] = i;
+    return all;
+  }
+  std::vector<int> some(count);
+  for (int i = 0; i < count; ++i)
+    some[i] = static_cast<int>(std::lround(i * (size - 1.0) / (count - 1)));
+  return some;
 }
 
 }  // namespace
@@ -221,7 +274,8 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
   std::vector<cv::Mat> images{dataset.Load(0).image};
   cv::Mat previous = ToGray8(images[0]);
   std::vector<cv::Point2f> corners;
-  cv::goodFeaturesToTrack(previous, corners, kMaxCorners, kCornerQuality, kCornerMinDistancePx);
+  cv::goodFeaturesToTrack(previous, corners, kMaxCorners, options.two_view_corner_quality,
+                          options.two_view_corner_min_distance_px);
   if (static_cast<int>(corners.size()) < options.two_view_min_inliers) {
     throw std::runtime_error("two-view bootstrap: frame 0 has " + std::to_string(corners.size()) +
                              " corners, fewer than two_view_min_inliers");
@@ -231,9 +285,18 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
 
   TwoViewBootstrap result;
   TwoViewGeometry geometry;
-  // The frame with enough corners and the largest rotation-free parallax so far (error message).
+  std::vector<Eigen::Quaterniond> rotations;
+  std::vector<Eigen::Vector3d> translations;
+  std::vector<Eigen::Vector3d> points;
+  // The frame with enough corners and the largest rotation-free parallax so far, and the smallest
+  // direction uncertainty of a frame that passed the parallax gates (error message).
   std::string best = "none";
   double best_free_px = -1.0;
+  double best_direction_std_deg = std::numeric_limits<double>::infinity();
+  int tested = 0;  // frames that passed the parallax gates
+  // Frame 0's view of the adjusted directions to the camera centres of the latest consecutive
+  // frames that passed the parallax gates (at most two_view_stable_frames).
+  std::deque<Eigen::Vector3d> directions;
   for (int k = 1; k < last && result.second_view < 0; ++k) {
     images.push_back(dataset.Load(k).image);
     const cv::Mat next = ToGray8(images.back());
@@ -252,37 +315,72 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
              " corners, " + std::to_string(geometry.median_parallax_deg) + " deg, rotation-free " +
              std::to_string(best_free_px) + " px";
     }
-    if (enough && geometry.median_parallax_deg >= options.two_view_min_parallax_deg &&
-        geometry.rotation_free_parallax_px >= options.two_view_min_rotation_free_parallax_px) {
+    if (!enough || geometry.median_parallax_deg < options.two_view_min_parallax_deg ||
+        geometry.rotation_free_parallax_px < options.two_view_min_rotation_free_parallax_px) {
+      directions.clear();
+      continue;
+    }
+    // The test adjustment (at most kMaxTestCorners corners over kMaxTestFrames frames). Frame k
+    // is the second view when it fixes k's translation direction and the directions of the last
+    // two_view_stable_frames frames agree: a wrong decomposition or a local minimum moves the
+    // direction from one frame to the next by more than its uncertainty.
+    std::vector<int> track_ids;
+    points.clear();
+    for (int i : EvenlySpaced(static_cast<int>(geometry.points.size()), kMaxTestCorners)) {
+      track_ids.push_back(geometry.track_ids[i]);
+      points.push_back(geometry.points[i]);
+    }
+    const std::vector<int> frames = EvenlySpaced(k + 1, kMaxTestFrames);
+    InterpolatePoses(geometry, frames, &rotations, &translations);
+    const double direction_std_deg =
+        BundleAdjust(tracks, track_ids, frames, K, &rotations, &translations, &points, true);
+    best_direction_std_deg = std::min(best_direction_std_deg, direction_std_deg);
+    ++tested;
+    directions.push_back(-(rotations.back().conjugate() * translations.back()).normalized());
+    if (static_cast<int>(directions.size()) > options.two_view_stable_frames) {
+      directions.pop_front();
+    }
+    const double max_deg = options.two_view_max_direction_std_deg;
+    bool agree = static_cast<int>(directions.size()) == options.two_view_stable_frames;
+    for (const Eigen::Vector3d& a : directions) {
+      for (const Eigen::Vector3d& b : directions) {
+        agree = agree && std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * 180.0 / M_PI <= max_deg;
+      }
+    }
+    if (direction_std_deg <= max_deg && agree) {
       result.second_view = k;
+      result.direction_std_deg = direction_std_deg;
     }
   }
   if (result.second_view < 0) {
-    throw std::runtime_error("two-view bootstrap: no frame up to " + std::to_string(last - 1) +
-                             " has " + std::to_string(options.two_view_min_inliers) +
-                             " corners triangulated with a median parallax of " +
-                             std::to_string(options.two_view_min_parallax_deg) +
-                             " deg and a rotation-free parallax of " +
-                             std::to_string(options.two_view_min_rotation_free_parallax_px) +
-                             " px (largest rotation-free with enough corners: " + best + ")");
+    std::string why = "no frame up to " + std::to_string(last - 1) + " has " +
+                      std::to_string(options.two_view_min_inliers) +
+                      " corners triangulated with a median parallax of " +
+                      std::to_string(options.two_view_min_parallax_deg) +
+                      " deg and a rotation-free parallax of " +
+                      std::to_string(options.two_view_min_rotation_free_parallax_px) +
+                      " px (largest rotation-free with enough corners: " + best + ")";
+    if (tested > 0) {
+      why = "no frame that passes the parallax gates fixes the translation direction to " +
+            std::to_string(options.two_view_max_direction_std_deg) + " deg (best " +
+            std::to_string(best_direction_std_deg) + " deg) with the " +
+            std::to_string(options.two_view_stable_frames) +
+            " last frames' directions agreeing to it";
+    }
+    throw std::runtime_error("two-view bootstrap: " + why);
   }
   result.tracks = static_cast<int>(tracks.size());
   result.inliers = static_cast<int>(geometry.points.size());
   result.parallax_deg = geometry.median_parallax_deg;
   result.rotation_free_parallax_px = geometry.rotation_free_parallax_px;
-
-  // Poses of frames 0..k (cam_from_ref) and corners, refined together over every frame.
   const int k = result.second_view;
-  const Eigen::Quaterniond rotation_k(geometry.rotation);
-  std::vector<Eigen::Quaterniond> rotations;
-  std::vector<Eigen::Vector3d> translations;
-  for (int j = 0; j <= k; ++j) {
-    const double f = static_cast<double>(j) / k;
-    rotations.push_back(Eigen::Quaterniond::Identity().slerp(f, rotation_k));
-    translations.push_back(f * geometry.translation);
-  }
-  std::vector<Eigen::Vector3d> points = geometry.points;
-  BundleAdjust(tracks, geometry.track_ids, K, &rotations, &translations, &points);
+
+  // The second view's poses of frames 1..k and its corners, adjusted over every frame.
+  std::vector<int> frames(k + 1);
+  for (int j = 0; j <= k; ++j) frames[j] = j;
+  InterpolatePoses(geometry, frames, &rotations, &translations);
+  points = geometry.points;
+  BundleAdjust(tracks, geometry.track_ids, frames, K, &rotations, &translations, &points, false);
 
   // Scale: median inverse depth of the corners in front of frame 0 is 1.
   std::vector<double> idepths;

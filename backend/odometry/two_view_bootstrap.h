@@ -6,19 +6,24 @@
 // pair of poses and map (docs/odometry.md, "Keyframe maps in monocular runs"). Here the first
 // frames' motion comes from image geometry instead, as in feature-based monocular SLAM
 // (ORB-SLAM, SVO):
-//   1. corners of frame 0 (Shi-Tomasi) are tracked frame to frame by pyramidal Lucas-Kanade
-//      with a forward-backward check;
+//   1. corners of frame 0 (Shi-Tomasi, down to corner_quality of the strongest) are tracked
+//      frame to frame by pyramidal Lucas-Kanade with a forward-backward check;
 //   2. at every frame k, the essential matrix between frame 0 and k (five-point RANSAC) and its
-//      decomposition give (R, t) and triangulated corners; k is the second view when at least
-//      min_inliers corners are triangulated in front of both cameras with a median parallax
-//      angle of at least min_parallax_deg, and the corners moved by at least
+//      decomposition give (R, t) and triangulated corners; k passes the parallax gates when at
+//      least min_inliers corners are triangulated in front of both cameras with a median
+//      parallax angle of at least min_parallax_deg, and the corners moved by at least
 //      min_rotation_free_parallax_px (median) more than the best-fitting rotation explains: with
 //      less, the essential matrix fits the tracking noise and its decomposition can be any
 //      motion, while the triangulated parallax of that motion still looks large;
-//   3. the poses of frames 1..k and the corners are refined together over all their observations
-//      (bundle adjustment with Ceres, Huber loss; frame 0 fixed, |t_k| fixed), starting from
-//      poses interpolated between frame 0 and the two-view pose;
-//   4. frame 0's semi-dense map is estimated from the random initialisation by the mapping's own
+//   3. such a frame is tested by a bundle adjustment of up to 200 of the corners over up to 8
+//      frames 0..k (Ceres, Huber loss; frame 0 fixed, |t_k| fixed): k is the second view when
+//      the adjusted translation direction's standard deviation (covariance for 1 px noise) is
+//      at most max_direction_std_deg and the adjusted directions of the last stable_frames
+//      consecutive tested frames agree to within it. Weak corners and forward motion leave the
+//      direction uncertain; a wrong decomposition or local minimum jumps from frame to frame;
+//   4. the poses of frames 1..k and all inlier corners are adjusted over every frame 0..k,
+//      starting from poses interpolated between frame 0 and the two-view pose;
+//   5. frame 0's semi-dense map is estimated from the random initialisation by the mapping's own
 //      stereo and EKF with the poses of frames 1..k (photometric stereo, no lines: both
 //      configurations start alike), with the scale set by a median corner inverse depth of 1.
 // The run then starts from that map (its observed hypotheses) with inverse-depth variance
@@ -45,8 +50,9 @@ struct TwoViewBootstrap {
   int inliers = 0;            // of which: essential-matrix inliers triangulated in front
   double parallax_deg = 0.0;  // their median parallax angle
   double rotation_free_parallax_px = 0.0;  // their median parallax no rotation explains
-  int points = 0;                          // observed hypotheses of frame 0's map
-  double ms = 0.0;                         // wall time
+  double direction_std_deg = 0.0;  // the adjusted translation direction's uncertainty (1 px noise)
+  int points = 0;                  // observed hypotheses of frame 0's map
+  double ms = 0.0;                 // wall time
 };
 
 // The parallax of the matched pixels x0[i] <-> xk[i] that no rotation explains, px: the median

@@ -174,12 +174,16 @@ TEST(TwoViewBootstrapTest, RecoversTheSecondViewAndFrameZerosMap) {
   std::printf(
       "second view %d, %d of %d corners, parallax %.2f deg (rotation-free %.2f px), rotation error "
       "%.3f deg, direction "
-      "error %.2f deg, map: %d points, median rel. error %.4f, pose scale / map scale %.3f\n",
+      "error %.2f deg (std %.2f deg), map: %d points, median rel. error %.4f, pose scale / map "
+      "scale %.3f\n",
       result.second_view, result.inliers, result.tracks, result.parallax_deg,
-      result.rotation_free_parallax_px, rotation_error_deg, direction_error_deg, result.points,
-      map_error, pose_scale / scale);
-  EXPECT_LT(rotation_error_deg, 0.25);
-  EXPECT_LT(direction_error_deg, 5.0);
+      result.rotation_free_parallax_px, rotation_error_deg, direction_error_deg,
+      result.direction_std_deg, result.points, map_error, pose_scale / scale);
+  // The direction within three of its standard deviations; the rotation within 0.5 deg (a
+  // direction error of a few degrees moves the rotation by a fraction of one).
+  EXPECT_LE(result.direction_std_deg, config.odometry.two_view_max_direction_std_deg);
+  EXPECT_LT(direction_error_deg, 3.0 * result.direction_std_deg);
+  EXPECT_LT(rotation_error_deg, 0.5);
   EXPECT_LT(map_error, 0.03);
   EXPECT_NEAR(pose_scale / scale, 1.0, 0.03);
 }
@@ -197,11 +201,12 @@ TEST(TwoViewBootstrapTest, StaticCameraHasNoParallax) {
 
 // The start of the lowtex preset at 320x240 (seed 1, 150-frame path): the camera turns 4.3 deg
 // and moves 1.9 cm in the first 6 frames, so the corners' motion is nearly all rotation (0.6 px
-// rotation-free at frame 6). The essential matrix of that noise decomposes into a motion whose
-// triangulated parallax passes the 2 deg gate with a translation 45 deg off the truth; this map
-// made every run from it fail (docs/bootstrap.md). The rotation-free parallax gate rejects every
-// frame up to 11, and without it (0 px) the wrong second view is accepted.
-TEST(TwoViewBootstrapTest, NearRotationIsRejectedByTheRotationFreeParallax) {
+// rotation-free at frame 6). With the strongest corners only (quality 0.01, 7 px apart) the
+// essential matrix of that noise decomposes into a motion whose triangulated parallax passes the
+// 2 deg gate with a translation 45 deg off the truth; this map made every run from it fail
+// (docs/bootstrap.md). Either gate rejects it on its own: the rotation-free parallax, and the
+// direction's uncertainty after the bundle adjustment.
+TEST(TwoViewBootstrapTest, NearRotationIsRejectedByEitherGate) {
   constexpr int kLowtexFrames = 12;
   const synthetic::SynthOptions options = test::SmallLowtexOptions(150);
   const synthetic::SyntheticSequence sequence = synthetic::MakeSequence(options);
@@ -214,29 +219,49 @@ TEST(TwoViewBootstrapTest, NearRotationIsRejectedByTheRotationFreeParallax) {
     frames.push_back(i);
   }
   const RenderedDataset dataset(sequence, images, frames);
-  OdometryConfig config;
-  try {
-    BootstrapFromTwoViews(dataset, config, kLowtexFrames);
-    ADD_FAILURE() << "a near-rotation start must not bootstrap";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("rotation-free"), std::string::npos) << e.what();
-  }
+  OdometryConfig strong_corners;
+  strong_corners.odometry.two_view_corner_quality = 0.01;
+  strong_corners.odometry.two_view_corner_min_distance_px = 7.0;
+  const auto rejection = [&](const OdometryConfig& config) -> std::string {
+    try {
+      BootstrapFromTwoViews(dataset, config, kLowtexFrames);
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
 
-  config.odometry.two_view_min_rotation_free_parallax_px = 0.0;
-  const TwoViewBootstrap unguarded = BootstrapFromTwoViews(dataset, config, kLowtexFrames);
+  OdometryConfig unguarded = strong_corners;
+  unguarded.odometry.two_view_min_rotation_free_parallax_px = 0.0;
+  unguarded.odometry.two_view_max_direction_std_deg = 180.0;
+  unguarded.odometry.two_view_stable_frames = 1;
+  const TwoViewBootstrap wrong = BootstrapFromTwoViews(dataset, unguarded, kLowtexFrames);
   const Trajectory& gt = *dataset.ground_truth();
   const SE3 true_second_from_first =
-      gt[unguarded.second_view].world_from_cam.Inverse() * gt[0].world_from_cam;
+      gt[wrong.second_view].world_from_cam.Inverse() * gt[0].world_from_cam;
   const double direction_error_deg =
-      AngleDeg(unguarded.second_from_first.translation(), true_second_from_first.translation());
+      AngleDeg(wrong.second_from_first.translation(), true_second_from_first.translation());
   std::printf(
-      "without the gate: second view %d, parallax %.2f deg, rotation-free %.3f px, "
-      "direction error %.1f deg\n",
-      unguarded.second_view, unguarded.parallax_deg, unguarded.rotation_free_parallax_px,
-      direction_error_deg);
-  EXPECT_LT(unguarded.rotation_free_parallax_px,
-            OdometryConfig().odometry.two_view_min_rotation_free_parallax_px);
+      "without the gates: second view %d, parallax %.2f deg, rotation-free %.3f px, "
+      "direction std %.1f deg, direction error %.1f deg\n",
+      wrong.second_view, wrong.parallax_deg, wrong.rotation_free_parallax_px,
+      wrong.direction_std_deg, direction_error_deg);
   EXPECT_GT(direction_error_deg, 20.0);
+  EXPECT_LT(wrong.rotation_free_parallax_px,
+            OdometryConfig().odometry.two_view_min_rotation_free_parallax_px);
+  EXPECT_GT(wrong.direction_std_deg, OdometryConfig().odometry.two_view_max_direction_std_deg);
+
+  OdometryConfig rotation_free_gate = unguarded;
+  rotation_free_gate.odometry.two_view_min_rotation_free_parallax_px =
+      OdometryConfig().odometry.two_view_min_rotation_free_parallax_px;
+  const std::string by_parallax = rejection(rotation_free_gate);
+  EXPECT_NE(by_parallax.find("no frame up to"), std::string::npos) << by_parallax;
+
+  OdometryConfig direction_gate = strong_corners;
+  direction_gate.odometry.two_view_min_rotation_free_parallax_px = 0.0;
+  const std::string by_direction = rejection(direction_gate);
+  EXPECT_NE(by_direction.find("fixes the translation direction"), std::string::npos)
+      << by_direction;
 }
 
 TEST(TwoViewBootstrapTest, BlankFrameHasNoCorners) {

@@ -332,8 +332,9 @@ TEST(RunCommandTest, BootstrapRefinementRerunsTheFirstKeyframeFrames) {
 }
 
 // odometry.two_view_bootstrap: the run reports the second view and tracks every frame from frame
-// 0's bootstrapped map (gates lowered to 0.3 deg and 1 px: this sequence moves forward and reaches
-// neither default in 36 frames; TwoViewBootstrapTest checks the geometry); when the bootstrap
+// 0's bootstrapped map (gates lowered to 0.3 deg, 1 px and a 30 deg direction uncertainty without
+// the stability check: this sequence moves forward and reaches no default in 36 frames;
+// TwoViewBootstrapTest checks the geometry); when the bootstrap
 // fails (two frames, no parallax) the run starts from the random map and says why; combinations
 // with the other starts are config errors.
 TEST(RunCommandTest, TwoViewBootstrapStartsTheRunOrFallsBack) {
@@ -342,7 +343,9 @@ TEST(RunCommandTest, TwoViewBootstrapStartsTheRunOrFallsBack) {
   ASSERT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " + run.string() + kFlags +
                       " --set odometry.two_view_bootstrap=true"
                       " --set odometry.two_view_min_parallax_deg=0.3"
-                      " --set odometry.two_view_min_rotation_free_parallax_px=1",
+                      " --set odometry.two_view_min_rotation_free_parallax_px=1"
+                      " --set odometry.two_view_max_direction_std_deg=30"
+                      " --set odometry.two_view_stable_frames=1",
                   TestRoot() / "run_two_view.log"),
             0)
       << Slurp(TestRoot() / "run_two_view.log");
@@ -354,6 +357,7 @@ TEST(RunCommandTest, TwoViewBootstrapStartsTheRunOrFallsBack) {
   EXPECT_LT(two_view["second_view"].get<int>(), 36);
   EXPECT_GE(two_view["parallax_deg"].get<double>(), 0.3);
   EXPECT_GE(two_view["rotation_free_parallax_px"].get<double>(), 1.0);
+  EXPECT_LE(two_view["direction_std_deg"].get<double>(), 30.0);
   EXPECT_GT(two_view["points"].get<int>(), 1000);
   EXPECT_EQ(summary["tracked"].get<int>(), 36);
 
