@@ -14,6 +14,7 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <numeric>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
@@ -222,15 +223,15 @@ void InterpolatePoses(const TwoViewGeometry& geometry, const std::vector<int>& f
 
 // At most `count` of 0..size - 1, evenly spaced, the first and the last among them.
 std::vector<int> EvenlySpaced(int size, int count) {
+  std::vector<int> indices(std::min(size, count));
   if (size <= count) {
-    std::vector<int> all(size);
-    for (int i = 0; i < size; ++i) all[i] = i;
-    return all;
+    std::iota(indices.begin(), indices.end(), 0);
+  } else {
+    for (int i = 0; i < count; ++i) {
+      indices[i] = static_cast<int>(std::lround(i * (size - 1.0) / (count - 1)));
+    }
   }
-  std::vector<int> some(count);
-  for (int i = 0; i < count; ++i)
-    some[i] = static_cast<int>(std::lround(i * (size - 1.0) / (count - 1)));
-  return some;
+  return indices;
 }
 
 }  // namespace
@@ -342,9 +343,10 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
     }
     const double max_deg = options.two_view_max_direction_std_deg;
     bool agree = static_cast<int>(directions.size()) == options.two_view_stable_frames;
-    for (const Eigen::Vector3d& a : directions) {
-      for (const Eigen::Vector3d& b : directions) {
-        agree = agree && std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * 180.0 / M_PI <= max_deg;
+    for (size_t i = 0; i < directions.size(); ++i) {
+      for (size_t j = i + 1; j < directions.size(); ++j) {
+        const double cos_angle = std::clamp(directions[i].dot(directions[j]), -1.0, 1.0);
+        agree = agree && std::acos(cos_angle) * 180.0 / M_PI <= max_deg;
       }
     }
     if (direction_std_deg <= max_deg && agree) {

@@ -208,7 +208,9 @@ TEST(ProblemBuilderTest, MaxRowsPerEdgeCapsTheInformationOfEachEdge) {
   const double uncapped = cost(on_longest, 0.0);
   ASSERT_GT(uncapped, 0.0);
   EXPECT_NEAR(cost(on_longest, kCap) / uncapped, kCap / count[longest], 1e-9);
-  if (!on_no_edge.empty()) EXPECT_EQ(cost(on_no_edge, kCap), cost(on_no_edge, 0.0));
+  if (!on_no_edge.empty()) {
+    EXPECT_EQ(cost(on_no_edge, kCap), cost(on_no_edge, 0.0));
+  }
 
   ProblemBuilderOptions bad;
   bad.max_rows_per_edge = -1.0;
