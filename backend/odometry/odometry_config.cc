@@ -59,6 +59,10 @@ std::string OdometryOptions::Check() const {
   }
   if (!(two_view_max_direction_std_deg > 0.0)) return "two_view_max_direction_std_deg must be > 0";
   if (two_view_stable_frames < 1) return "two_view_stable_frames must be >= 1";
+  if (two_view_photometric_passes < 0) return "two_view_photometric_passes must be >= 0";
+  if (!(two_view_photometric_outlier_factor >= 0.0)) {
+    return "two_view_photometric_outlier_factor must be >= 0";
+  }
   return "";
 }
 

@@ -188,6 +188,12 @@ struct OdometryOptions {
   double two_view_corner_min_distance_px = 5.0;
   double two_view_max_direction_std_deg = 3.0;
   int two_view_stable_frames = 3;
+  // Passes of the direct refinement after the corners: frames 0..k (at most 8 evenly spaced)
+  // and frame 0's map adjusted photometrically (the windowed BA's residuals, frame 0 hosting;
+  // DSO's outlier test at the given factor, 0: off), the frames between moved with them, then
+  // the map estimated again from the refined poses. 0 passes: the corners' poses only.
+  int two_view_photometric_passes = 1;
+  double two_view_photometric_outlier_factor = 0.0;
   // Solver comparison (docs/tracking.md): every tracked frame's final tracking problem (the same
   // reference, lines and initial pose) is solved a second time with this solver; its poses, RPE
   // and time are reported beside the run's (summary.json `compare_solver`,
@@ -283,6 +289,12 @@ struct OdometryOptions {
             "Two-view bootstrap: consecutive frames passing the gates whose adjusted translation "
             "directions must agree to within two_view_max_direction_std_deg; the last is the "
             "second view (1 = no check, default 3).");
+    v.Field("two_view_photometric_passes", &two_view_photometric_passes,
+            "Two-view bootstrap: passes of photometric adjustment of frames 0..k (at most 8) "
+            "and frame 0's map, each followed by the map's stereo again (0 = off, default 1).");
+    v.Field("two_view_photometric_outlier_factor", &two_view_photometric_outlier_factor,
+            "Two-view bootstrap: the photometric refinement leaves out a point's frame whose "
+            "energy exceeds factor^2 x the median (DSO's outlier test; 0 = off, default 0).");
     v.Choice("compare_solver", &compare_solver,
              ChoiceNames<CompareSolver>{{"none", CompareSolver::kNone},
                                         {"ceres", CompareSolver::kCeres},

@@ -181,6 +181,7 @@ InitialMap PrepareInitialMap(const Dataset& dataset, const OdometryConfig& confi
                           {"parallax_deg", two_view.parallax_deg},
                           {"rotation_free_parallax_px", two_view.rotation_free_parallax_px},
                           {"direction_std_deg", two_view.direction_std_deg},
+                          {"photometric_points", two_view.photometric_points},
                           {"points", two_view.points},
                           {"ms", two_view.ms}};
       std::cerr << "pldvo run: two-view bootstrap: second view frame " << two_view.second_view
@@ -188,6 +189,7 @@ InitialMap PrepareInitialMap(const Dataset& dataset, const OdometryConfig& confi
                 << " corners triangulated, median parallax " << two_view.parallax_deg
                 << " deg, rotation-free " << two_view.rotation_free_parallax_px
                 << " px, direction std " << two_view.direction_std_deg << " deg, "
+                << two_view.photometric_points << " points refined photometrically, "
                 << two_view.points << " hypotheses, " << static_cast<int>(two_view.ms) << " ms\n";
     } catch (const std::exception& e) {
       std::cerr << "pldvo run: " << e.what() << "; the run starts from the random map\n";

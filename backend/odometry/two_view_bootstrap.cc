@@ -14,6 +14,7 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
@@ -25,6 +26,8 @@
 
 #include "backend/mapping/depth_map_io.h"
 #include "backend/mapping/depth_mapper.h"
+#include "backend/windowed_ba/windowed_ba_solver.h"
+#include "core/image_pyramid.h"
 #include "core/statistics.h"
 #include "core/wall_clock.h"
 
@@ -47,6 +50,10 @@ constexpr int kMaxBundleIterations = 50;
 // at most this many corners and frames, evenly spread: its cost grows with their product.
 constexpr int kMaxTestCorners = 200;
 constexpr int kMaxTestFrames = 8;
+// The photometric refinement: frame 0's points (DSO's per-window budget) and LM iterations; its
+// frames are chosen as the test adjustment's.
+constexpr int kPhotometricPoints = 2000;
+constexpr int kPhotometricIterations = 50;
 
 cv::Mat ToGray8(const cv::Mat& image) {
   cv::Mat gray;
@@ -263,6 +270,70 @@ double RotationFreeParallaxPx(const std::vector<cv::Point2f>& x0,
   return Median(parallax_px);
 }
 
+// The frames between two refined ones (`refined`, increasing) take the correction of their poses
+// interpolated on SE(3): poses[j] = Exp((1 - w) Log(C_a) + w Log(C_b)) before[j], C = refined
+// pose * pose before^-1 of the neighbours a < j < b, w = (j - a) / (b - a).
+void InterpolateCorrections(const std::vector<int>& refined, const std::vector<SE3>& before,
+                            std::vector<SE3>* poses) {
+  for (size_t n = 0; n + 1 < refined.size(); ++n) {
+    const int a = refined[n];
+    const int b = refined[n + 1];
+    const Vector6d log_a = ((*poses)[a] * before[a].Inverse()).Log();
+    const Vector6d log_b = ((*poses)[b] * before[b].Inverse()).Log();
+    for (int j = a + 1; j < b; ++j) {
+      const double w = static_cast<double>(j - a) / (b - a);
+      (*poses)[j] = SE3::Exp((1.0 - w) * log_a + w * log_b) * before[j];
+    }
+  }
+}
+
+// Step 5: frames `frames` (0 first, at the identity) and the observed hypotheses of frame 0's
+// map adjusted by the windowed BA's photometric residuals (eq. 2, frame 0 hosting every point,
+// affine brightness, DSO's outlier test at outlier_factor, 0: off); frame 0 and the baseline to
+// the next frame hold the gauge. No inverse-depth prior: the map's variances come from the poses
+// being corrected. Replaces the refined frames' poses and returns the points adjusted; 0 when it
+// failed.
+int RefinePhotometrically(const std::vector<cv::Mat>& images, const SemiDenseDepthMap& map,
+                          const PinholeCamera& camera, const std::vector<int>& frames,
+                          double outlier_factor, std::vector<SE3>* poses) {
+  WindowedBAWindow window;
+  window.camera = camera;
+  for (const int j : frames) {
+    WindowedBAKeyframe keyframe;
+    keyframe.id = j;
+    keyframe.cam_from_world = (*poses)[j];
+    keyframe.pyramid = std::make_shared<const ImagePyramid>(ToGray8(images[j]), 1);
+    window.keyframes.push_back(std::move(keyframe));
+  }
+  std::vector<WindowedBAPoint>& points = window.keyframes.front().points;
+  for (int y = 0; y < map.height(); ++y) {
+    for (int x = 0; x < map.width(); ++x) {
+      const int i = map.Index(x, y);
+      if (!map.observed(i) || !(map.idepth_var(i) > 0.f) || !(map.idepth(i) > 0.f)) continue;
+      WindowedBAPoint point;
+      point.pixel = Eigen::Vector2d(x, y);
+      point.idepth = map.idepth(i);
+      point.idepth_var = map.idepth_var(i);
+      points.push_back(point);
+    }
+  }
+  WindowedBAOptions options;
+  options.window = static_cast<int>(frames.size());
+  options.max_points = kPhotometricPoints * options.window;  // the budget is split per frame
+  options.lines = false;
+  options.idepth_prior_scale = 0.0;
+  options.outlier_energy_factor = outlier_factor;
+  options.max_iterations = kPhotometricIterations;
+  const WindowedBAResult result = RunWindowedBA(window, options);
+  if (result.points.empty() || !(result.summary.final_cost <= result.summary.initial_cost)) {
+    return 0;
+  }
+  for (const WindowedBAResultKeyframe& keyframe : result.keyframes) {
+    (*poses)[keyframe.id] = keyframe.cam_from_world;
+  }
+  return static_cast<int>(result.points.size());
+}
+
 TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryConfig& config,
                                        int num_frames) {
   const auto start = WallClock::now();
@@ -395,19 +466,34 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
   const double scale = Median(idepths);
 
   // Frame 0's map from the random initialisation, fused with frames 1..k in order (small
-  // baselines first, as in the run).
-  DepthMapper mapper(camera, config.mapping);
-  mapper.InitializeKeyframe(images[0], EdgeTrace());
-  for (int j = 1; j <= k; ++j) {
-    mapper.UpdateWithFrame(images[j], SE3(rotations[j], translations[j] * scale), {});
+  // baselines first, as in the run); each photometric pass (step 5) refines the poses and the map
+  // is estimated again from them.
+  std::vector<SE3> poses;
+  for (int j = 0; j <= k; ++j) poses.emplace_back(rotations[j], translations[j] * scale);
+  auto estimate_map = [&]() {
+    auto mapper = std::make_unique<DepthMapper>(camera, config.mapping);
+    mapper->InitializeKeyframe(images[0], EdgeTrace());
+    for (int j = 1; j <= k; ++j) mapper->UpdateWithFrame(images[j], poses[j], {});
+    return mapper;
+  };
+  std::unique_ptr<DepthMapper> mapper = estimate_map();
+  const std::vector<int> refined = EvenlySpaced(k + 1, kMaxTestFrames);
+  for (int pass = 0; pass < options.two_view_photometric_passes; ++pass) {
+    const std::vector<SE3> unrefined = poses;
+    const int adjusted = RefinePhotometrically(images, mapper->depth_map(), camera, refined,
+                                               options.two_view_photometric_outlier_factor, &poses);
+    if (adjusted == 0) break;
+    result.photometric_points = adjusted;
+    InterpolateCorrections(refined, unrefined, &poses);
+    mapper = estimate_map();
   }
 
   double median_idepth = 0.0;  // of the map: `depth` is in units of 1 / median_idepth
-  result.depth = NormalizedObservedDepth(mapper.depth_map(), &result.points, &median_idepth);
+  result.depth = NormalizedObservedDepth(mapper->depth_map(), &result.points, &median_idepth);
   if (result.depth.empty()) {
     throw std::runtime_error("two-view bootstrap: frame 0's map has no observed hypothesis");
   }
-  result.second_from_first = SE3(rotations[k], translations[k] * scale * median_idepth);
+  result.second_from_first = SE3(poses[k].rotation(), poses[k].translation() * median_idepth);
   result.ms = MsSince(start);
   return result;
 }

@@ -25,7 +25,12 @@
 //      starting from poses interpolated between frame 0 and the two-view pose;
 //   5. frame 0's semi-dense map is estimated from the random initialisation by the mapping's own
 //      stereo and EKF with the poses of frames 1..k (photometric stereo, no lines: both
-//      configurations start alike), with the scale set by a median corner inverse depth of 1.
+//      configurations start alike), with the scale set by a median corner inverse depth of 1;
+//      then, for each of two_view_photometric_passes, up to 8 evenly spaced frames 0..k and
+//      2000 of the map's points are adjusted photometrically (the windowed BA's eq. 2 rows,
+//      frame 0 hosting; DSO's initialiser adjusts poses and depths jointly in the same way),
+//      the frames between take the interpolated correction, and the map is estimated again.
+//      Corners drift by a pixel or two over tens of frames; the image's edges do not.
 // The run then starts from that map (its observed hypotheses) with inverse-depth variance
 // odometry.bootstrap_idepth_var, and tracks frames 1..k again.
 #ifndef PLDVO_BACKEND_ODOMETRY_TWO_VIEW_BOOTSTRAP_H_
@@ -51,6 +56,7 @@ struct TwoViewBootstrap {
   double parallax_deg = 0.0;  // their median parallax angle
   double rotation_free_parallax_px = 0.0;  // their median parallax no rotation explains
   double direction_std_deg = 0.0;  // the adjusted translation direction's uncertainty (1 px noise)
+  int photometric_points = 0;      // adjusted in the last photometric pass (0: none)
   int points = 0;                  // observed hypotheses of frame 0's map
   double ms = 0.0;                 // wall time
 };

@@ -358,6 +358,7 @@ TEST(RunCommandTest, TwoViewBootstrapStartsTheRunOrFallsBack) {
   EXPECT_GE(two_view["parallax_deg"].get<double>(), 0.3);
   EXPECT_GE(two_view["rotation_free_parallax_px"].get<double>(), 1.0);
   EXPECT_LE(two_view["direction_std_deg"].get<double>(), 30.0);
+  EXPECT_GT(two_view["photometric_points"].get<int>(), 0);
   EXPECT_GT(two_view["points"].get<int>(), 1000);
   EXPECT_EQ(summary["tracked"].get<int>(), 36);
 
