@@ -270,7 +270,9 @@ TEST(MappingWorkerTest, TrackingGetsTheLaggedMapOnEitherThread) {
       if (parallel) worker.Flush();  // inline, Flush runs the held-back updates
       EXPECT_EQ(worker.MapForTracking(0)->num_updates, std::max(0, i - kLag)) << "update " << i;
     }
-    if (parallel) EXPECT_EQ(worker.Latest()->num_updates, kUpdates);
+    if (parallel) {
+      EXPECT_EQ(worker.Latest()->num_updates, kUpdates);
+    }
     MappingJob next = KeyframeJob(MappingJob::Kind::kNewKeyframe, 1, kUpdates + 1, image);
     next.new_from_old = SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(-0.06, 0.0, 0.0));
     worker.Submit(std::move(next));
