@@ -26,6 +26,7 @@
 
 #include "backend/mapping/depth_map_io.h"
 #include "backend/mapping/depth_mapper.h"
+#include "backend/odometry/windowed_ba_keyframes.h"
 #include "backend/windowed_ba/windowed_ba_solver.h"
 #include "core/image_pyramid.h"
 #include "core/statistics.h"
@@ -305,18 +306,7 @@ int RefinePhotometrically(const std::vector<cv::Mat>& images, const SemiDenseDep
     keyframe.pyramid = std::make_shared<const ImagePyramid>(ToGray8(images[j]), 1);
     window.keyframes.push_back(std::move(keyframe));
   }
-  std::vector<WindowedBAPoint>& points = window.keyframes.front().points;
-  for (int y = 0; y < map.height(); ++y) {
-    for (int x = 0; x < map.width(); ++x) {
-      const int i = map.Index(x, y);
-      if (!map.observed(i) || !(map.idepth_var(i) > 0.f) || !(map.idepth(i) > 0.f)) continue;
-      WindowedBAPoint point;
-      point.pixel = Eigen::Vector2d(x, y);
-      point.idepth = map.idepth(i);
-      point.idepth_var = map.idepth_var(i);
-      points.push_back(point);
-    }
-  }
+  window.keyframes.front().points = ObservedWindowPoints(map);
   WindowedBAOptions options;
   options.window = static_cast<int>(frames.size());
   options.max_points = kPhotometricPoints * options.window;  // the budget is split per frame
@@ -450,7 +440,7 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
 
   // The second view's poses of frames 1..k and its corners, adjusted over every frame.
   std::vector<int> frames(k + 1);
-  for (int j = 0; j <= k; ++j) frames[j] = j;
+  std::iota(frames.begin(), frames.end(), 0);
   InterpolatePoses(geometry, frames, &rotations, &translations);
   points = geometry.points;
   BundleAdjust(tracks, geometry.track_ids, frames, K, &rotations, &translations, &points, false);

@@ -67,28 +67,30 @@ void WindowedBAKeyframes::Clear() {
   submitted_.clear();
 }
 
+std::vector<WindowedBAPoint> ObservedWindowPoints(const SemiDenseDepthMap& map) {
+  std::vector<WindowedBAPoint> points;
+  for (int y = 0; y < map.height(); ++y) {
+    for (int x = 0; x < map.width(); ++x) {
+      const int i = map.Index(x, y);
+      if (!map.observed(i) || !(map.idepth_var(i) > 0.f) || !std::isfinite(map.idepth(i))) {
+        continue;
+      }
+      WindowedBAPoint point;
+      point.pixel = Eigen::Vector2d(x, y);
+      point.idepth = map.idepth(i);
+      point.idepth_var = map.idepth_var(i);
+      point.edge_id = map.edge_id(i);
+      points.push_back(point);
+    }
+  }
+  return points;
+}
+
 bool WindowedBAKeyframes::SetPoints(int id, const SemiDenseDepthMap& map) {
   if (map.width() != camera_.width || map.height() != camera_.height) return false;
   for (Keyframe& keyframe : keyframes_) {
     if (keyframe.record.id != id) continue;
-    auto points = std::make_shared<std::vector<WindowedBAPoint>>();
-    for (int y = 0; y < map.height(); ++y) {
-      for (int x = 0; x < map.width(); ++x) {
-        const int i = map.Index(x, y);
-        // Observed hypotheses only: random initial guesses and hole-filled ones carry no
-        // information for the BA's inverse-depth prior.
-        if (!map.observed(i) || !(map.idepth_var(i) > 0.f) || !std::isfinite(map.idepth(i))) {
-          continue;
-        }
-        WindowedBAPoint point;
-        point.pixel = Eigen::Vector2d(x, y);
-        point.idepth = map.idepth(i);
-        point.idepth_var = map.idepth_var(i);
-        point.edge_id = map.edge_id(i);
-        points->push_back(point);
-      }
-    }
-    keyframe.points = std::move(points);
+    keyframe.points = std::make_shared<std::vector<WindowedBAPoint>>(ObservedWindowPoints(map));
     return true;
   }
   return false;

@@ -46,6 +46,11 @@ struct KeyframePoseRecord {
   int windows = 0;  // applied BA results that moved it
 };
 
+// The windowed BA's candidate points of a keyframe's depth map: its observed hypotheses with a
+// finite inverse depth and a positive variance, row by row. Random initial guesses and
+// hole-filled hypotheses carry no information for the BA's inverse-depth prior.
+std::vector<WindowedBAPoint> ObservedWindowPoints(const SemiDenseDepthMap& map);
+
 class WindowedBAKeyframes {
  public:
   // Keeps the newest `size` keyframes (>= 2). Throws std::invalid_argument otherwise.
