@@ -105,6 +105,20 @@ double EstimateIntensityNoiseSigma(const std::vector<double>& errors,
   return std::exp(0.5 * (a + b));
 }
 
+double EstimateLineNoiseScale(const std::vector<double>& errors,
+                              const std::vector<double>& depth_variances,
+                              const std::vector<double>& line_variances) {
+  const size_t rows = errors.size();
+  if (depth_variances.size() != rows || line_variances.size() != rows) return 0.0;
+  std::vector<double> normalized_errors(rows), normalized_depth_variances(rows);
+  for (size_t j = 0; j < rows; ++j) {
+    if (!(line_variances[j] > 0.0)) return 0.0;
+    normalized_errors[j] = errors[j] / std::sqrt(line_variances[j]);
+    normalized_depth_variances[j] = depth_variances[j] / line_variances[j];
+  }
+  return EstimateIntensityNoiseSigma(normalized_errors, normalized_depth_variances, 1.0);
+}
+
 EdgeLineWeights SharedLineErrorWeights(const LineWithCovariance& line_in_cur,
                                        const std::vector<Eigen::Vector2d>& pixels_cur,
                                        const std::vector<double>& point_variances) {

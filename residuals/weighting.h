@@ -38,7 +38,7 @@ namespace pldvo {
 enum class WeightingPolicy { kCovariance, kUniform, kFixedRatio, kPhotometricOnly, kLineOnly };
 enum class RobustLossKind { kNone, kHuber, kCauchy };
 enum class LineErrorModel { kPerPixel, kSharedPerEdge };
-enum class IntensityNoiseSource { kFixed, kEstimated };
+enum class NoiseSource { kFixed, kEstimated };
 
 inline const ChoiceNames<WeightingPolicy>& WeightingPolicyNames() {
   static const ChoiceNames<WeightingPolicy> names = {
@@ -55,9 +55,9 @@ inline const ChoiceNames<LineErrorModel>& LineErrorModelNames() {
       {"shared_per_edge", LineErrorModel::kSharedPerEdge}};
   return names;
 }
-inline const ChoiceNames<IntensityNoiseSource>& IntensityNoiseSourceNames() {
-  static const ChoiceNames<IntensityNoiseSource> names = {
-      {"fixed", IntensityNoiseSource::kFixed}, {"estimated", IntensityNoiseSource::kEstimated}};
+inline const ChoiceNames<NoiseSource>& NoiseSourceNames() {
+  static const ChoiceNames<NoiseSource> names = {{"fixed", NoiseSource::kFixed},
+                                                 {"estimated", NoiseSource::kEstimated}};
   return names;
 }
 
@@ -77,7 +77,13 @@ struct WeightingOptions {
   // frame's photometric errors at its solution, EstimateIntensityNoiseSigma: scales with the
   // contrast, so the ratio of photometric to line weights does not; sigma_intensity then only
   // serves the first frame).
-  IntensityNoiseSource intensity_noise = IntensityNoiseSource::kFixed;
+  NoiseSource intensity_noise = NoiseSource::kFixed;
+  // Where the scale of a line's covariance Sigma_l (eq. 6) comes from: fixed (as the line
+  // frontend fits it, lines.detector.endpoint_sigma_px) or estimated (Sigma_l times s^2, s from
+  // the previous frame's point-to-line errors at its solution, EstimateLineNoiseScale: lines
+  // noisier than the detector's model, as on low contrast, blur or occlusion edges, weigh less).
+  // Tracking only; policies covariance and line_only.
+  NoiseSource line_noise = NoiseSource::kFixed;
   // "fixed_ratio" only: the pixel scale of a line row, sqrt_info = sqrt(lambda) / line_sigma_px.
   // (The covariance policies take Sigma_l from the matched segment, which the line frontend
   // fits with lines.detector.endpoint_sigma_px.)
@@ -105,9 +111,12 @@ struct WeightingOptions {
              "How photometric and point-to-line residuals are weighted: covariance (the paper), "
              "uniform, fixed_ratio, photometric_only, line_only.");
     v.Field("sigma_intensity", &sigma_intensity, "Image noise sigma_I in gray levels.");
-    v.Choice("intensity_noise", &intensity_noise, IntensityNoiseSourceNames(),
+    v.Choice("intensity_noise", &intensity_noise, NoiseSourceNames(),
              "Where sigma_I comes from: fixed (sigma_intensity) or estimated (from the previous "
              "frame's photometric errors; contrast-invariant weights).");
+    v.Choice("line_noise", &line_noise, NoiseSourceNames(),
+             "Scale of the lines' covariance: fixed (the line frontend's) or estimated (from the "
+             "previous frame's point-to-line errors).");
     v.Field("line_sigma_px", &line_sigma_px,
             "fixed_ratio only: pixel scale of a line row (covariance policies take Sigma_l from "
             "the segments, lines.detector.endpoint_sigma_px).");
@@ -168,6 +177,16 @@ double EstimateIntensityNoiseSigma(const std::vector<double>& errors,
                                    const std::vector<double>& other_variances, double noise_factor);
 constexpr int kMinIntensityNoiseRows = 50;
 constexpr double kIntensityNoiseFloorFraction = 0.25;
+
+// The scale s of the lines' covariance that the point-to-line errors g_j at a solution imply,
+// given each row's variance s^2 L_j + D_j (L_j = x'^T Sigma_l x' with the frontend's Sigma_l,
+// D_j = l^T Sigma_x' l the depth part of eq. 6): the s at which the whitened errors have unit
+// robust scale, 1.4826 median_j |g_j| / sqrt(s^2 L_j + D_j) = 1. The same root as
+// EstimateIntensityNoiseSigma of g_j / sqrt(L_j) with depth parts D_j / L_j and k = 1, and the
+// same bounds and 0 for no estimate (also when some L_j <= 0).
+double EstimateLineNoiseScale(const std::vector<double>& errors,
+                              const std::vector<double>& depth_variances,
+                              const std::vector<double>& line_variances);
 
 // The robust loss of the options, or nullptr for "none". Pass it to the cost functions (which
 // do not own it) or to ceres::Problem (which does, unless told otherwise).

@@ -239,24 +239,32 @@ void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
 
 FrameUpdateStats DepthMapper::UpdateWithFrame(const cv::Mat& image, const SE3& cur_from_ref,
                                               const std::vector<MatchedLine>& lines_in_cur,
-                                              const Matrix6d& pose_covariance) {
+                                              const Matrix6d& pose_covariance,
+                                              double line_cov_scale) {
   if (image.empty() || image.cols != map_.width() || image.rows != map_.height() ||
       image.channels() != 1) {
     throw std::invalid_argument(
         "DepthMapper::UpdateWithFrame: frame must be a gray image of the keyframe's size");
+  }
+  if (!(line_cov_scale > 0.0) || !std::isfinite(line_cov_scale)) {
+    throw std::invalid_argument("DepthMapper::UpdateWithFrame: line_cov_scale must be positive");
   }
   FrameUpdateStats stats;
   const ImagePyramid current(image, 1);
   const EpipolarGeometry geometry(camera_, cur_from_ref, pose_covariance);
   if (!(cur_from_ref.translation().norm() > 0.0)) return stats;  // no baseline, no stereo
   // Matches whose line most of the edge's hypotheses contradict are left out for this frame; the
-  // edge's pixels then search like pixels without a line.
+  // edge's pixels then search like pixels without a line. The kept lines' Sigma_l2 take the
+  // line noise scale.
   const std::vector<MatchedLine>* lines = &lines_in_cur;
   std::vector<MatchedLine> kept;
-  if (options_.use_line_stereo && options_.line_match_max_outside_fraction < 1.0) {
+  const bool check_matches = options_.line_match_max_outside_fraction < 1.0;
+  if (options_.use_line_stereo && (check_matches || line_cov_scale != 1.0)) {
     kept = lines_in_cur;
-    const std::vector<char> inconsistent = InconsistentLineMatches(geometry, kept);
-    for (size_t e = 0; e < kept.size(); ++e) {
+    for (MatchedLine& line : kept) line.line_in_cur.cov *= line_cov_scale;
+    const std::vector<char> inconsistent =
+        check_matches ? InconsistentLineMatches(geometry, kept) : std::vector<char>();
+    for (size_t e = 0; e < inconsistent.size(); ++e) {
       if (!inconsistent[e]) continue;
       kept[e].matched = false;
       stats.dropped_line_matches.push_back(static_cast<int>(e));

@@ -98,10 +98,12 @@ class DepthMapper {
   // keyframe edge e (the id in the keyframe's EdgeTrace); missing or unmatched entries use the
   // SSD search. `pose_covariance`: the tracked pose's error (tracking.pose_covariance), added
   // to the epipolar line's position error of every stereo observation; zero: the constant
-  // mapping.sigma_epipolar_px alone.
+  // mapping.sigma_epipolar_px alone. `line_cov_scale`: s^2 that multiplies the current lines'
+  // covariances Sigma_l2 in eq. 10 (mapping.line_stereo_estimated_line_noise; 1: as fitted).
   FrameUpdateStats UpdateWithFrame(const cv::Mat& image, const SE3& cur_from_ref,
                                    const std::vector<MatchedLine>& lines_in_cur,
-                                   const Matrix6d& pose_covariance = Matrix6d::Zero());
+                                   const Matrix6d& pose_covariance = Matrix6d::Zero(),
+                                   double line_cov_scale = 1.0);
 
   // Fuses the edge BA's optimised 3D lines (keyframe frame, with tangent covariances;
   // edge_ba_line_depth.h): every valid pixel whose edge id has a line gets the inverse depth of

@@ -95,6 +95,12 @@ struct MappingOptions {
   // apply and the EKF's outlier gate decides, as in the paper (the default: dropping them did
   // not pay on the development set, docs/deviations.md).
   bool line_stereo_prior_interval = false;
+  // Scale the current line's position error in eq. 10 (x'^T Sigma_l2 x') by s^2, s the line
+  // noise scale that the tracked frame's point-to-line errors imply (Tracker,
+  // EstimateLineNoiseScale, whose model is that same term; the update's `line_cov_scale`): lines
+  // noisier than the detector's model give less certain depths. false: Sigma_l2 as fitted
+  // (paper.yaml).
+  bool line_stereo_estimated_line_noise = true;
   // A match is left out for a frame when more than this fraction of its edge's hypotheses (and
   // at least line_match_min_votes of them) put the intersection outside their prior interval: a
   // wrong match (docs/mapping.md, "Wrong frontend matches on textured"). 1 = off.
@@ -233,6 +239,9 @@ struct MappingOptions {
     v.Field("line_stereo_prior_interval", &line_stereo_prior_interval,
             "Drop line-guided matches outside the prior interval idepth +- search_sigmas sigma; "
             "false leaves them to the EKF's outlier gate, as the paper (default false).");
+    v.Field("line_stereo_estimated_line_noise", &line_stereo_estimated_line_noise,
+            "Scale the current line's position error in eq. 10 by the line noise the tracked "
+            "frame's point-to-line errors imply (default true).");
     v.Field("line_match_max_outside_fraction", &line_match_max_outside_fraction,
             "Leave a line match out for a frame when more than this fraction of its edge's "
             "hypotheses put the intersection outside their prior interval (1 = off, default).");

@@ -214,7 +214,7 @@ void MappingWorker::Run(const MappingJob& job) {
       case MappingJob::Kind::kUpdate:
         if (job.keyframe_id != keyframe_id_) return;  // for a keyframe no longer current
         mapper_.UpdateWithFrame(InReferenceBrightness(job.image, job.brightness), job.cur_from_kf,
-                                job.lines_in_cur, job.pose_covariance);
+                                job.lines_in_cur, job.pose_covariance, job.line_cov_scale);
         ++num_updates_;
         if (updates_since_random_init_ >= 0) ++updates_since_random_init_;
         break;

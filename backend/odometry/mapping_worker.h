@@ -73,6 +73,9 @@ struct MappingJob {
   std::vector<MatchedLine> lines_in_cur;
   // kUpdate: the tracked pose's covariance (tracking.pose_covariance; zero when not computed).
   Matrix6d pose_covariance = Matrix6d::Zero();
+  // kUpdate: s^2 of the current lines' covariance in the line-guided stereo (1: as fitted;
+  // mapping.line_stereo_estimated_line_noise).
+  double line_cov_scale = 1.0;
   // kInitialize / kNewKeyframe: the new keyframe's traced edges and pyramid levels.
   EdgeTrace edges;
   int num_levels = 1;

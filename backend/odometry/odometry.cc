@@ -616,6 +616,7 @@ void Odometry::UpdateReference(const std::vector<MatchedLine>& lines_in_cur,
   }
   SetMatchedLines(lines_in_cur, &reference_);
   reference_.intensity_noise_sigma = intensity_noise_sigma_;
+  reference_.line_noise_scale = line_noise_scale_;
   timing->reference_ms = MsSince(start);
 }
 
@@ -689,10 +690,11 @@ void Odometry::AcceptTrackedFrame(int index, const TrackingResult& tracking,
   world_from_last_good_ = world_from_cur;
   last_good_index_ = index;
   brightness_ = tracking.brightness;
-  if (config_.tracking.problem.weighting.intensity_noise == IntensityNoiseSource::kEstimated &&
+  if (config_.tracking.problem.weighting.intensity_noise == NoiseSource::kEstimated &&
       tracking.intensity_noise_sigma > 0.0) {
     intensity_noise_sigma_ = tracking.intensity_noise_sigma;
   }
+  if (tracking.line_noise_scale > 0.0) line_noise_scale_ = tracking.line_noise_scale;
   retry_trigger_.Update(tracking);
   result->world_from_cam = world_from_cur;
   result->status = recovering_ ? FrameStatus::kRecovered : FrameStatus::kTracked;
@@ -749,6 +751,9 @@ void Odometry::MapOrSwitchKeyframe(int index, double timestamp, const cv::Mat& i
   job.pose_covariance = tracking.pose_covariance;
   job.brightness = brightness_;
   job.lines_in_cur = std::move(association.lines_in_cur);
+  if (config_.mapping.line_stereo_estimated_line_noise && line_noise_scale_ > 0.0) {
+    job.line_cov_scale = line_noise_scale_ * line_noise_scale_;
+  }
   mapper_->Submit(std::move(job));
 }
 

@@ -273,6 +273,10 @@ class Odometry {
   // tracking.problem.weighting.intensity_noise estimated: sigma_I of the last tracked frame's
   // solution (0 until one), given to the tracking reference of the next frame.
   double intensity_noise_sigma_ = 0.0;
+  // The line covariance scale s of the last tracked frame's solution with line rows (0 before
+  // the first): the next frame's tracking reference gets it (weighting.line_noise estimated
+  // uses it), and so does the mapping update (mapping.line_stereo_estimated_line_noise).
+  double line_noise_scale_ = 0.0;
   RetryTrigger retry_trigger_;
   int consecutive_lost_ = 0;
   bool recovering_ = false;   // a frame was lost since the last tracked one

@@ -367,7 +367,7 @@ struct OdometryConfig {
   // keyframe when the photometric misfit grows 1.5x (docs/odometry.md, "Keyframes").
   OdometryConfig() {
     lines.detector.method = LineDetectorOptions::Method::kEdLines;
-    tracking.problem.weighting.intensity_noise = IntensityNoiseSource::kEstimated;
+    tracking.problem.weighting.intensity_noise = NoiseSource::kEstimated;
     keyframes.max_rms_growth = 1.5;
   }
 

@@ -94,7 +94,8 @@ class RunFiles {
                 << dataset_label << "\n";
     timing_ << "index,timestamp,status,keyframe_id,lines,matches,line_outliers,reference_points,"
                "alternatives,iterations,final_rms,inlier_fraction,intensity_correlation,"
-               "brightness_a,brightness_b,pose_sigma_t,pose_sigma_r_deg";
+               "brightness_a,brightness_b,pose_sigma_t,pose_sigma_r_deg,intensity_noise_sigma,"
+               "line_noise_scale";
     for (const char* key : kTimingKeys) timing_ << "," << key << "_ms";
     timing_ << "\n";
     Flush(trajectory_, "trajectory.txt");
@@ -120,7 +121,8 @@ class RunFiles {
             << tracking.TotalIterations() << "," << std::setprecision(6) << tracking.final_rms
             << "," << tracking.inlier_fraction << "," << tracking.intensity_correlation << ","
             << tracking.brightness.a << "," << tracking.brightness.b << "," << pose_sigma_t << ","
-            << pose_sigma_r_deg;
+            << pose_sigma_r_deg << "," << tracking.intensity_noise_sigma << ","
+            << tracking.line_noise_scale;
     for (double value : row) timing_ << "," << std::setprecision(4) << value;
     timing_ << "\n";
     Flush(timing_, "timing.csv");

@@ -191,6 +191,37 @@ double Tracker::IntensityNoiseAtSolution(const TrackingReference& reference,
   return EstimateIntensityNoiseSigma(errors, other_variances, noise_factor);
 }
 
+double Tracker::LineNoiseAtSolution(const TrackingReference& reference,
+                                    const SE3& cur_from_ref) const {
+  const WeightingOptions& weighting = options_.problem.weighting;
+  if (weighting.policy != WeightingPolicy::kCovariance &&
+      weighting.policy != WeightingPolicy::kLineOnly) {
+    return 0.0;
+  }
+  const TrackingReferenceLevel& ref = reference.levels[options_.finest_level];
+  std::vector<double> errors, depth_variances, line_variances;
+  for (const ReferencePoint& point : ref.points) {
+    if (point.edge_id < 0 || point.edge_id >= static_cast<int>(ref.lines_in_cur.size()) ||
+        !ref.lines_in_cur[point.edge_id].matched) {
+      continue;
+    }
+    const LineWithCovariance& line = ref.lines_in_cur[point.edge_id].line_in_cur;
+    Eigen::Vector2d pixel_cur;
+    if (!Reproject(ref.camera, cur_from_ref, point.pixel_on_edge, point.idepth, &pixel_cur) ||
+        !ref.camera.IsInside(pixel_cur, 0.0)) {
+      continue;
+    }
+    const Eigen::Matrix3d pixel_cov = ReprojectedPixelCovariance(
+        ref.camera, cur_from_ref, point.pixel_on_edge, point.idepth, point.idepth_var);
+    errors.push_back(line.line.dot(pixel_cur.homogeneous()));
+    depth_variances.push_back(
+        PointToLineVariance(line.line, Eigen::Matrix3d::Zero(), pixel_cur, pixel_cov));
+    line_variances.push_back(
+        PointToLineVariance(line.line, line.cov, pixel_cur, Eigen::Matrix3d::Zero()));
+  }
+  return EstimateLineNoiseScale(errors, depth_variances, line_variances);
+}
+
 TrackingResult Tracker::Track(const TrackingReference& reference, const ImagePyramid& current,
                               const SE3& initial_cur_from_ref,
                               const AffineBrightness& initial_brightness,
@@ -280,6 +311,7 @@ TrackingResult Tracker::TrackLevels(const TrackingReference& reference, const Im
     }
     if (level == options_.finest_level) {
       result.intensity_noise_sigma = IntensityNoiseAtSolution(reference, final_stats);
+      result.line_noise_scale = LineNoiseAtSolution(reference, PoseFromParameters(pose));
     }
   }
 

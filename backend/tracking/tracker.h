@@ -129,6 +129,10 @@ struct TrackingResult {
   // solution (EstimateIntensityNoiseSigma); 0 when there are too few rows or sigma_I does not
   // enter the policy.
   double intensity_noise_sigma = 0.0;
+  // The scale s of the lines' covariance the finest level's point-to-line errors imply at the
+  // solution (EstimateLineNoiseScale), whichever weighting.line_noise; 0 when there are too few
+  // line rows or Sigma_l does not enter the policy.
+  double line_noise_scale = 0.0;
   // With TrackingOptions::pose_covariance: (J~^T J~)^-1 of the finest level at cur_from_ref,
   // the pose block of it when the brightness is estimated too (whitened, robustified rows, so
   // the inverse of the Gauss-Newton normal matrix); zero otherwise or when J~ is rank deficient.
@@ -181,6 +185,9 @@ class Tracker {
   // TrackingResult::intensity_noise_sigma from the finest level's statistics.
   double IntensityNoiseAtSolution(const TrackingReference& reference,
                                   const ResidualStatistics& stats) const;
+
+  // TrackingResult::line_noise_scale at the finest level's solution `cur_from_ref`.
+  double LineNoiseAtSolution(const TrackingReference& reference, const SE3& cur_from_ref) const;
 
   TrackingOptions options_;
   std::unique_ptr<ProblemBuilder> builder_;

@@ -134,6 +134,11 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
   if (reference.intensity_noise_sigma > 0.0) {
     weighting.sigma_intensity = reference.intensity_noise_sigma;
   }
+  // With weighting.line_noise estimated, the reference's line noise scale s multiplies every
+  // Sigma_l by s^2.
+  const double s = reference.line_noise_scale;
+  const double line_cov_scale =
+      weighting.line_noise == NoiseSource::kEstimated && s > 0.0 ? s * s : 1.0;
 
   ceres::LossFunction* loss = nullptr;
   if (std::unique_ptr<ceres::LossFunction> made = MakeLossFunction(weighting)) {
@@ -181,7 +186,8 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
                                  (weighting.policy == WeightingPolicy::kCovariance ||
                                   weighting.policy == WeightingPolicy::kLineOnly);
   if (shared_line_error) {
-    AddSharedLineErrorBlocks(ref, level, pose, loss_inside, cur_from_ref, problem, &stats);
+    AddSharedLineErrorBlocks(ref, level, pose, line_cov_scale, loss_inside, cur_from_ref, problem,
+                             &stats);
   } else if (UsesLines(weighting.policy)) {
     std::vector<PointToLineObservation> observations;
     observations.reserve(batch);
@@ -198,8 +204,10 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
     for (const ReferencePoint& point : ref.points) {
       const MatchedLine* line = MatchedLineOf(ref, point, level);
       if (line == nullptr) continue;
+      LineWithCovariance line_in_cur = line->line_in_cur;
+      line_in_cur.cov *= line_cov_scale;
       const double sqrt_info = LineSqrtInfo(weighting, camera, pose, point.pixel_on_edge,
-                                            point.idepth, point.idepth_var, line->line_in_cur);
+                                            point.idepth, point.idepth_var, line_in_cur);
       if (!(sqrt_info > 0.0)) continue;
       PointToLineObservation observation;
       observation.pixel_in_ref = point.pixel_on_edge;
@@ -214,9 +222,12 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
   return stats;
 }
 
-void TrackingProblemBuilder::AddSharedLineErrorBlocks(
-    const TrackingReferenceLevel& ref, int level, const SE3& pose, const ceres::LossFunction* loss,
-    double* cur_from_ref, LeastSquaresProblem* problem, BuildStatistics* stats) const {
+void TrackingProblemBuilder::AddSharedLineErrorBlocks(const TrackingReferenceLevel& ref, int level,
+                                                      const SE3& pose, double line_cov_scale,
+                                                      const ceres::LossFunction* loss,
+                                                      double* cur_from_ref,
+                                                      LeastSquaresProblem* problem,
+                                                      BuildStatistics* stats) const {
   const PinholeCamera& camera = ref.camera;
   std::vector<std::vector<int>> points_of_edge(ref.lines_in_cur.size());
   for (int i = 0; i < static_cast<int>(ref.points.size()); ++i) {
@@ -229,7 +240,8 @@ void TrackingProblemBuilder::AddSharedLineErrorBlocks(
   std::vector<Eigen::Vector2d> pixels_cur;
   std::vector<double> point_variances;
   for (size_t edge = 0; edge < points_of_edge.size(); ++edge) {
-    const LineWithCovariance& line = ref.lines_in_cur[edge].line_in_cur;
+    LineWithCovariance line = ref.lines_in_cur[edge].line_in_cur;
+    line.cov *= line_cov_scale;
     std::vector<PointToLineObservation> observations;
     pixels_cur.clear();
     point_variances.clear();

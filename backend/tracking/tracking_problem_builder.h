@@ -51,8 +51,9 @@ class TrackingProblemBuilder : public ProblemBuilder {
   // line_error_model shared_per_edge: one block per matched edge, its rows whitened against the
   // shared line error (residuals/weighting.h SharedLineErrorWeights).
   void AddSharedLineErrorBlocks(const TrackingReferenceLevel& ref, int level, const SE3& pose,
-                                const ceres::LossFunction* loss, double* cur_from_ref,
-                                LeastSquaresProblem* problem, BuildStatistics* stats) const;
+                                double line_cov_scale, const ceres::LossFunction* loss,
+                                double* cur_from_ref, LeastSquaresProblem* problem,
+                                BuildStatistics* stats) const;
 
   ProblemBuilderOptions options_;
   bool loss_in_problem_;

@@ -53,6 +53,10 @@ struct TrackingReference {
   // configured tracking.problem.weighting.sigma_intensity (weighting.intensity_noise estimated
   // sets it from the previous frame, EstimateIntensityNoiseSigma).
   double intensity_noise_sigma = 0.0;
+  // s of the line rows' covariance s^2 Sigma_l for the frames tracked against it, with
+  // weighting.line_noise estimated (the previous frame's EstimateLineNoiseScale); 0: 1, the line
+  // frontend's Sigma_l.
+  double line_noise_scale = 0.0;
   int num_levels() const { return static_cast<int>(levels.size()); }
 };
 

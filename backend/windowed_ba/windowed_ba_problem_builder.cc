@@ -329,6 +329,11 @@ std::string WindowedBAOptions::Check() const {
   if (max_queue < 1) return "max_queue must be >= 1";
   const std::string weighting_error = weighting.Check();
   if (!weighting_error.empty()) return "weighting: " + weighting_error;
+  // The noise estimates come from a tracked frame's solution, which a window does not have.
+  if (weighting.intensity_noise != NoiseSource::kFixed ||
+      weighting.line_noise != NoiseSource::kFixed) {
+    return "weighting: intensity_noise and line_noise must be fixed (estimated is tracking's)";
+  }
   return "";
 }
 

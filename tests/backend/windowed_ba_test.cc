@@ -390,6 +390,9 @@ TEST(WindowedBATest, RegistryAndOptions) {
   options = WindowedBAOptions();
   options.outlier_energy_factor = -1.0;
   EXPECT_NE(options.Check().find("outlier_energy_factor"), std::string::npos);
+  options = WindowedBAOptions();
+  options.weighting.line_noise = NoiseSource::kEstimated;
+  EXPECT_NE(options.Check().find("line_noise must be fixed"), std::string::npos);
 }
 
 }  // namespace

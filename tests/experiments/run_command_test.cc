@@ -100,7 +100,9 @@ TEST(RunCommandTest, WritesAllOutputs) {
   std::getline(std::ifstream(out / "timing.csv"), header);
   EXPECT_EQ(header.rfind("index,timestamp,status,keyframe_id,lines,matches,line_outliers,", 0), 0u)
       << header;
-  EXPECT_NE(header.find(",pose_sigma_t,pose_sigma_r_deg,"), std::string::npos) << header;
+  EXPECT_NE(header.find(",pose_sigma_t,pose_sigma_r_deg,intensity_noise_sigma,line_noise_scale,"),
+            std::string::npos)
+      << header;
   for (const std::vector<std::string>& row : CsvRows(out / "timing.csv")) {
     ASSERT_GT(row.size(), 6u);
     EXPECT_GE(std::stoi(row[6]), 0);

@@ -51,8 +51,10 @@ void ExpectExtras(const OdometryConfig& config, bool on, const std::string& name
   EXPECT_EQ(config.mapping.ssd_ambiguity_variance, on);
   EXPECT_EQ(config.mapping.line_stereo_check_ssd, on);
   EXPECT_EQ(config.mapping.line_stereo_keyframe_line_var, on);
+  EXPECT_EQ(config.mapping.line_stereo_estimated_line_noise, on);
   // Off in every config: the paper's behaviour paid on the development set.
   EXPECT_FALSE(config.mapping.line_stereo_prior_interval);
+  EXPECT_EQ(config.tracking.problem.weighting.line_noise, NoiseSource::kFixed);
   // The paper's 3D line regularisation is one of the things the default leaves out.
   EXPECT_EQ(config.mapping.line_regularization, !on);
   EXPECT_EQ(config.mapping.line_regularization_method,
@@ -66,7 +68,7 @@ void ExpectExtras(const OdometryConfig& config, bool on, const std::string& name
   EXPECT_EQ(config.odometry.line_consensus_max_cost_drop, on ? 8.4 : 0.0);
   EXPECT_EQ(config.odometry.random_map_warmup_updates, on ? 3 : 0);
   EXPECT_EQ(config.tracking.problem.weighting.intensity_noise,
-            on ? IntensityNoiseSource::kEstimated : IntensityNoiseSource::kFixed);
+            on ? NoiseSource::kEstimated : NoiseSource::kFixed);
   EXPECT_EQ(config.keyframes.max_rms_growth, on ? 1.5 : 0.0);
   EXPECT_EQ(config.tracking.problem.max_rows_per_edge, on ? 50.0 : 0.0);
 }
@@ -117,7 +119,7 @@ const std::map<std::string, std::function<void(const OdometryConfig&)>>& Cases()
          EXPECT_FALSE(c.mapping.use_line_stereo);
          EXPECT_FALSE(c.mapping.line_regularization);
          EXPECT_TRUE(c.odometry.two_view_bootstrap);  // the same start as points_lines
-         EXPECT_EQ(c.tracking.problem.weighting.intensity_noise, IntensityNoiseSource::kFixed);
+         EXPECT_EQ(c.tracking.problem.weighting.intensity_noise, NoiseSource::kFixed);
          EXPECT_EQ(c.keyframes.max_rms_growth, 0.0);
        }},
       {"lines_only",
