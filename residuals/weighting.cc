@@ -110,11 +110,13 @@ double EstimateLineNoiseScale(const std::vector<double>& errors,
                               const std::vector<double>& line_variances) {
   const size_t rows = errors.size();
   if (depth_variances.size() != rows || line_variances.size() != rows) return 0.0;
-  std::vector<double> normalized_errors(rows), normalized_depth_variances(rows);
+  std::vector<double> normalized_errors, normalized_depth_variances;
+  normalized_errors.reserve(rows);
+  normalized_depth_variances.reserve(rows);
   for (size_t j = 0; j < rows; ++j) {
-    if (!(line_variances[j] > 0.0)) return 0.0;
-    normalized_errors[j] = errors[j] / std::sqrt(line_variances[j]);
-    normalized_depth_variances[j] = depth_variances[j] / line_variances[j];
+    if (!(line_variances[j] > 0.0)) continue;
+    normalized_errors.push_back(errors[j] / std::sqrt(line_variances[j]));
+    normalized_depth_variances.push_back(depth_variances[j] / line_variances[j]);
   }
   return EstimateIntensityNoiseSigma(normalized_errors, normalized_depth_variances, 1.0);
 }

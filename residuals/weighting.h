@@ -113,10 +113,10 @@ struct WeightingOptions {
     v.Field("sigma_intensity", &sigma_intensity, "Image noise sigma_I in gray levels.");
     v.Choice("intensity_noise", &intensity_noise, NoiseSourceNames(),
              "Where sigma_I comes from: fixed (sigma_intensity) or estimated (from the previous "
-             "frame's photometric errors; contrast-invariant weights).");
+             "frame's photometric errors; contrast-invariant weights; tracking only).");
     v.Choice("line_noise", &line_noise, NoiseSourceNames(),
              "Scale of the lines' covariance: fixed (the line frontend's) or estimated (from the "
-             "previous frame's point-to-line errors).");
+             "previous frame's point-to-line errors; tracking only).");
     v.Field("line_sigma_px", &line_sigma_px,
             "fixed_ratio only: pixel scale of a line row (covariance policies take Sigma_l from "
             "the segments, lines.detector.endpoint_sigma_px).");
@@ -183,7 +183,8 @@ constexpr double kIntensityNoiseFloorFraction = 0.25;
 // D_j = l^T Sigma_x' l the depth part of eq. 6): the s at which the whitened errors have unit
 // robust scale, 1.4826 median_j |g_j| / sqrt(s^2 L_j + D_j) = 1. The same root as
 // EstimateIntensityNoiseSigma of g_j / sqrt(L_j) with depth parts D_j / L_j and k = 1, and the
-// same bounds and 0 for no estimate (also when some L_j <= 0).
+// same bounds and 0 for no estimate (fewer than kMinIntensityNoiseRows rows with L_j > 0, or
+// mismatched sizes).
 double EstimateLineNoiseScale(const std::vector<double>& errors,
                               const std::vector<double>& depth_variances,
                               const std::vector<double>& line_variances);

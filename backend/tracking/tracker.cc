@@ -199,6 +199,11 @@ double Tracker::LineNoiseAtSolution(const TrackingReference& reference,
     return 0.0;
   }
   const TrackingReferenceLevel& ref = reference.levels[options_.finest_level];
+  // The builder's point part of a row: shared_per_edge adds the edge pixel's own error.
+  const double edge_pixel_sigma =
+      weighting.line_error_model == LineErrorModel::kSharedPerEdge
+          ? std::ldexp(weighting.edge_pixel_sigma_px, -options_.finest_level)
+          : 0.0;
   std::vector<double> errors, depth_variances, line_variances;
   for (const ReferencePoint& point : ref.points) {
     if (point.edge_id < 0 || point.edge_id >= static_cast<int>(ref.lines_in_cur.size()) ||
@@ -215,7 +220,8 @@ double Tracker::LineNoiseAtSolution(const TrackingReference& reference,
         ref.camera, cur_from_ref, point.pixel_on_edge, point.idepth, point.idepth_var);
     errors.push_back(line.line.dot(pixel_cur.homogeneous()));
     depth_variances.push_back(
-        PointToLineVariance(line.line, Eigen::Matrix3d::Zero(), pixel_cur, pixel_cov));
+        PointToLineVariance(line.line, Eigen::Matrix3d::Zero(), pixel_cur, pixel_cov) +
+        edge_pixel_sigma * edge_pixel_sigma);
     line_variances.push_back(
         PointToLineVariance(line.line, line.cov, pixel_cur, Eigen::Matrix3d::Zero()));
   }

@@ -136,9 +136,11 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
   }
   // With weighting.line_noise estimated, the reference's line noise scale s multiplies every
   // Sigma_l by s^2.
-  const double s = reference.line_noise_scale;
+  const double line_noise_scale = reference.line_noise_scale;
   const double line_cov_scale =
-      weighting.line_noise == NoiseSource::kEstimated && s > 0.0 ? s * s : 1.0;
+      weighting.line_noise == NoiseSource::kEstimated && line_noise_scale > 0.0
+          ? line_noise_scale * line_noise_scale
+          : 1.0;
 
   ceres::LossFunction* loss = nullptr;
   if (std::unique_ptr<ceres::LossFunction> made = MakeLossFunction(weighting)) {

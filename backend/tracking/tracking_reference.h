@@ -54,8 +54,8 @@ struct TrackingReference {
   // sets it from the previous frame, EstimateIntensityNoiseSigma).
   double intensity_noise_sigma = 0.0;
   // s of the line rows' covariance s^2 Sigma_l for the frames tracked against it, with
-  // weighting.line_noise estimated (the previous frame's EstimateLineNoiseScale); 0: 1, the line
-  // frontend's Sigma_l.
+  // weighting.line_noise estimated (the previous frame's EstimateLineNoiseScale); 0: Sigma_l
+  // unscaled.
   double line_noise_scale = 0.0;
   int num_levels() const { return static_cast<int>(levels.size()); }
 };

@@ -365,12 +365,16 @@ TEST(LineNoise, LineWeightsDoNotDependOnTheAssumedEndpointSigma) {
                 1e-9 * scale / c)
         << "c " << c;
   }
-  // No estimate for a row without a line part or mismatched sizes.
+  // A row without a line part is left out; mismatched sizes give no estimate.
   std::vector<double> broken = line_variances;
   broken[7] = 0.0;
-  EXPECT_EQ(EstimateLineNoiseScale(sample.errors, sample.other_variances, broken), 0.0);
-  broken.pop_back();
-  EXPECT_EQ(EstimateLineNoiseScale(sample.errors, sample.other_variances, broken), 0.0);
+  std::vector<double> errors = sample.errors, depth = sample.other_variances, line = line_variances;
+  for (auto* v : {&errors, &depth, &line}) v->erase(v->begin() + 7);
+  EXPECT_EQ(EstimateLineNoiseScale(sample.errors, sample.other_variances, broken),
+            EstimateLineNoiseScale(errors, depth, line));
+  std::vector<double> shorter = line_variances;
+  shorter.pop_back();
+  EXPECT_EQ(EstimateLineNoiseScale(sample.errors, sample.other_variances, shorter), 0.0);
 }
 
 TEST(IntensityNoise, NoEstimateWithoutEnoughRowsOrImageNoise) {
