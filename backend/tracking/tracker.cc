@@ -206,11 +206,9 @@ double Tracker::LineNoiseAtSolution(const TrackingReference& reference,
           : 0.0;
   std::vector<double> errors, depth_variances, line_variances;
   for (const ReferencePoint& point : ref.points) {
-    if (point.edge_id < 0 || point.edge_id >= static_cast<int>(ref.lines_in_cur.size()) ||
-        !ref.lines_in_cur[point.edge_id].matched) {
-      continue;
-    }
-    const LineWithCovariance& line = ref.lines_in_cur[point.edge_id].line_in_cur;
+    const MatchedLine* matched = MatchedLineOf(ref, point, options_.finest_level);
+    if (matched == nullptr) continue;
+    const LineWithCovariance& line = matched->line_in_cur;
     Eigen::Vector2d pixel_cur;
     if (!Reproject(ref.camera, cur_from_ref, point.pixel_on_edge, point.idepth, &pixel_cur) ||
         !ref.camera.IsInside(pixel_cur, 0.0)) {

@@ -17,19 +17,6 @@ namespace {
 
 std::string Where(int line) { return std::string(__FILE__) + ":" + std::to_string(line) + ": "; }
 
-// The current line matched to the point's edge; nullptr when the point is on no edge or its
-// edge has no match. Throws when the edge id has no entry in the level's lines.
-const MatchedLine* MatchedLineOf(const TrackingReferenceLevel& ref, const ReferencePoint& point,
-                                 int level) {
-  if (point.edge_id < 0) return nullptr;
-  if (point.edge_id >= static_cast<int>(ref.lines_in_cur.size())) {
-    throw std::invalid_argument(Where(__LINE__) + "edge id " + std::to_string(point.edge_id) +
-                                " has no line entry at level " + std::to_string(level));
-  }
-  const MatchedLine& line = ref.lines_in_cur[point.edge_id];
-  return line.matched ? &line : nullptr;
-}
-
 }  // namespace
 
 std::vector<double> EdgeRowScales(const TrackingReferenceLevel& ref, double max_rows_per_edge) {

@@ -81,6 +81,17 @@ constexpr double kMinMatchedLength = 10.0;  // px at level 0 inside the current 
 
 }  // namespace
 
+const MatchedLine* MatchedLineOf(const TrackingReferenceLevel& ref, const ReferencePoint& point,
+                                 int level) {
+  if (point.edge_id < 0) return nullptr;
+  if (point.edge_id >= static_cast<int>(ref.lines_in_cur.size())) {
+    throw std::invalid_argument(Where(__LINE__) + "edge id " + std::to_string(point.edge_id) +
+                                " has no line entry at level " + std::to_string(level));
+  }
+  const MatchedLine& line = ref.lines_in_cur[point.edge_id];
+  return line.matched ? &line : nullptr;
+}
+
 std::string GroundTruthReferenceOptions::Check() const {
   if (num_levels < 1) return "num_levels must be >= 1";
   if (!(gradient_threshold >= 0.0)) return "gradient_threshold must be >= 0";

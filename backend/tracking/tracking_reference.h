@@ -60,6 +60,12 @@ struct TrackingReference {
   int num_levels() const { return static_cast<int>(levels.size()); }
 };
 
+// The matched current-frame line of `point`'s edge at `level`, or nullptr when the point is on
+// no edge or its edge has no match. Throws std::invalid_argument when the edge id has no entry
+// in `lines_in_cur` (an inconsistent reference).
+const MatchedLine* MatchedLineOf(const TrackingReferenceLevel& ref, const ReferencePoint& point,
+                                 int level);
+
 // A level-0 line (with covariance) expressed in the pixels of `level`: with s = 2^level,
 // l_level = (a, b, (a + b)(s - 1) / (2 s) + c / s), which keeps a^2 + b^2 = 1 and is linear in
 // l for a normalised line, so Sigma_level = M Sigma M^T with that linear map M.

@@ -12,6 +12,7 @@
 #include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -59,6 +60,21 @@ TEST(TrackingReferenceTest, LineAtLevelMatchesFitLineOfScaledEndpoints) {
     EXPECT_LT((mapped.cov - direct.cov).norm(), 1e-12 * direct.cov.norm());
     EXPECT_LT((PixelAtLevel0(PixelAtLevel(p1, level), level) - p1).norm(), 1e-12);
   }
+}
+
+TEST(TrackingReferenceTest, MatchedLineOfFollowsTheEdgeIdAndRejectsAMissingEntry) {
+  TrackingReferenceLevel ref;
+  ref.lines_in_cur.resize(2);
+  ref.lines_in_cur[1].matched = true;
+  ReferencePoint point;
+  point.edge_id = -1;
+  EXPECT_EQ(MatchedLineOf(ref, point, 0), nullptr);  // on no edge
+  point.edge_id = 0;
+  EXPECT_EQ(MatchedLineOf(ref, point, 0), nullptr);  // its edge unmatched
+  point.edge_id = 1;
+  EXPECT_EQ(MatchedLineOf(ref, point, 0), &ref.lines_in_cur[1]);
+  point.edge_id = 2;
+  EXPECT_THROW(MatchedLineOf(ref, point, 0), std::invalid_argument);
 }
 
 TEST(TrackingReferenceTest, GroundTruthEdgePointsLieOnTheirLinesAtTheTruePose) {
