@@ -30,6 +30,7 @@ void FrameUpdateStats::AddCounts(const FrameUpdateStats& other) {
   line_fallback += other.line_fallback;
   line_rejected += other.line_rejected;
   line_out_of_range += other.line_out_of_range;
+  line_narrow_prior += other.line_narrow_prior;
   ssd_attempts += other.ssd_attempts;
   ssd_ok += other.ssd_ok;
   fused += other.fused;
@@ -145,6 +146,19 @@ std::vector<char> DepthMapper::InconsistentLineMatches(
   return inconsistent;
 }
 
+bool DepthMapper::NarrowPrior(int index, const Eigen::Vector2d& pixel,
+                              const EpipolarGeometry& geometry, double idepth_min,
+                              double idepth_max) const {
+  if (!(options_.line_stereo_min_interval_px > 0.0) || !map_.valid(index) ||
+      map_.num_observations(index) == 0) {
+    return false;
+  }
+  Eigen::Vector2d end_far, end_near;
+  return geometry.Project(pixel, idepth_min, &end_far) &&
+         geometry.Project(pixel, idepth_max, &end_near) &&
+         (end_near - end_far).norm() < options_.line_stereo_min_interval_px;
+}
+
 void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
                               const EpipolarGeometry& geometry,
                               const std::vector<MatchedLine>& lines_in_cur,
@@ -160,8 +174,12 @@ void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
   StereoStatus status = StereoStatus::kBadGeometry;
 
   const int edge = map_.edge_id(index);
-  const bool has_line = options_.use_line_stereo && edge >= 0 &&
-                        edge < static_cast<int>(lines_in_cur.size()) && lines_in_cur[edge].matched;
+  const bool matched = options_.use_line_stereo && edge >= 0 &&
+                       edge < static_cast<int>(lines_in_cur.size()) && lines_in_cur[edge].matched;
+  // A converged hypothesis is refined by the SSD within its interval instead of the line.
+  const bool narrow = matched && NarrowPrior(index, pixel, geometry, idepth_min, idepth_max);
+  stats->line_narrow_prior += narrow;
+  const bool has_line = matched && !narrow;
   using SsdUse = MappingOptions::LineStereoSsd;
   const bool ssd_first =
       has_line && options_.line_stereo_ssd == SsdUse::kFirst && patch_status == StereoStatus::kOk;

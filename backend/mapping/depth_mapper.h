@@ -49,6 +49,9 @@ struct FrameUpdateStats {
   int line_fallback = 0;      // near-parallel: fell back to the SSD search
   int line_rejected = 0;      // out of the prior interval or failed the SSD check
   int line_out_of_range = 0;  // of which: outside the prior interval idepth +- 2 sigma
+  // Edge pixels with a matched line searched by the SSD instead: their prior interval is
+  // narrower than options.line_stereo_min_interval_px.
+  int line_narrow_prior = 0;
   // Edge ids whose match was left out because most of the edge's hypotheses put the
   // intersection outside their prior interval (options.line_match_max_outside_fraction).
   std::vector<int> dropped_line_matches;
@@ -165,6 +168,10 @@ class DepthMapper {
   // and more than line_match_max_outside_fraction of those lie outside).
   std::vector<char> InconsistentLineMatches(const EpipolarGeometry& geometry,
                                             const std::vector<MatchedLine>& lines_in_cur) const;
+  // The pixel's hypothesis is observed and its prior interval [idepth_min, idepth_max] spans
+  // less than options.line_stereo_min_interval_px on the epipolar line.
+  bool NarrowPrior(int index, const Eigen::Vector2d& pixel, const EpipolarGeometry& geometry,
+                   double idepth_min, double idepth_max) const;
   // Stereo + fusion of one candidate pixel.
   void UpdatePixel(int index, const ImagePyramid& current, const EpipolarGeometry& geometry,
                    const std::vector<MatchedLine>& lines_in_cur, FrameUpdateStats* stats);

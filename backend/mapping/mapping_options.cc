@@ -33,6 +33,7 @@ std::string MappingOptions::Check() const {
   if (max_ssd_rms <= 0.0) error << "max_ssd_rms must be > 0; ";
   if (ssd_uniqueness_ratio < 1.0) error << "ssd_uniqueness_ratio must be >= 1; ";
   if (max_epipolar_scale < 1.0) error << "max_epipolar_scale must be >= 1; ";
+  if (!(line_stereo_min_interval_px >= 0.0)) error << "line_stereo_min_interval_px must be >= 0; ";
   if (min_line_epipolar_angle_deg < 0.0 || min_line_epipolar_angle_deg >= 90.0) {
     error << "min_line_epipolar_angle_deg must be in [0, 90); ";
   }

@@ -95,6 +95,13 @@ struct MappingOptions {
   // apply and the EKF's outlier gate decides, as in the paper (the default: dropping them did
   // not pay on the development set, docs/deviations.md).
   bool line_stereo_prior_interval = false;
+  // Line-guided stereo only for a pixel whose prior interval (idepth +- search_sigmas sigma)
+  // spans at least this many pixels of the epipolar line, or that has no observation yet; a
+  // narrower hypothesis is searched by the SSD within its interval: the line converges a
+  // hypothesis, the SSD refines it (docs/mapping.md, "Lines converge, the SSD refines").
+  // 0 (default): the line-guided stereo wherever the line is well-conditioned, as the paper; 4
+  // did not pay on the development set.
+  double line_stereo_min_interval_px = 0.0;
   // Scale the current line's position error in eq. 10 (x'^T Sigma_l2 x') by s^2, s the line
   // noise scale that the tracked frame's point-to-line errors imply (Tracker,
   // EstimateLineNoiseScale, whose model is that same term; the update's `line_cov_scale`): lines
@@ -239,6 +246,10 @@ struct MappingOptions {
     v.Field("line_stereo_prior_interval", &line_stereo_prior_interval,
             "Drop line-guided matches outside the prior interval idepth +- search_sigmas sigma; "
             "false leaves them to the EKF's outlier gate, as the paper (default false).");
+    v.Field("line_stereo_min_interval_px", &line_stereo_min_interval_px,
+            "Line-guided stereo only where the pixel's prior interval spans at least this many "
+            "px (or it has no observation); narrower ones are searched by the SSD within it; "
+            "0: always, as the paper (default 0).");
     v.Field("line_stereo_estimated_line_noise", &line_stereo_estimated_line_noise,
             "Scale the current line's position error in eq. 10 by the line noise the tracked "
             "frame's point-to-line errors imply (default true).");

@@ -529,6 +529,43 @@ TEST(DepthMapperTest, LineCovarianceScaleWidensTheLineGuidedObservations) {
                std::invalid_argument);
 }
 
+TEST(DepthMapperTest, NarrowPriorsAreSearchedByTheSsdAndUnobservedOnesByTheLine) {
+  // mapping.line_stereo_min_interval_px: an observed hypothesis whose prior interval spans less
+  // than that on the epipolar line is refined by the SSD instead of the line-guided stereo; a
+  // hypothesis without observations (the random start) keeps the line.
+  const WrongMatchCase c = MakeWrongMatchCase();
+  FrameUpdateStats from_depth[4];
+  const double thresholds[4] = {0.0, 1e6, 0.5, 1.0};
+  for (int k = 0; k < 4; ++k) {
+    MappingOptions options;
+    options.line_stereo_min_interval_px = thresholds[k];
+    DepthMapper mapper(c.camera, options);
+    // Inverse-depth sigma 0.01: +- 2 sigma spans 0.5-1 px of the epipolar line in this pair.
+    mapper.InitializeKeyframeFromDepth(c.keyframe_image, c.edges.trace, c.depth, 1e-4);
+    from_depth[k] = mapper.UpdateWithFrame(c.image, c.cur_from_ref, c.lines);
+  }
+  ASSERT_GT(from_depth[0].line_attempts, 1000);
+  EXPECT_EQ(from_depth[0].line_narrow_prior, 0);
+  // Every matched edge pixel is narrower than 1e6 px: none goes to the line, all to the SSD.
+  EXPECT_EQ(from_depth[1].line_attempts, 0);
+  EXPECT_EQ(from_depth[1].line_narrow_prior, from_depth[0].line_attempts);
+  EXPECT_GT(from_depth[1].ssd_attempts, from_depth[0].ssd_attempts);
+  // The threshold is in pixels of the interval: all are wider than 0.5 px, none than 1 px.
+  EXPECT_EQ(from_depth[2].line_narrow_prior, 0);
+  EXPECT_EQ(from_depth[2].line_attempts, from_depth[0].line_attempts);
+  EXPECT_EQ(from_depth[3].line_narrow_prior, from_depth[0].line_attempts);
+
+  MappingOptions options;
+  options.line_stereo_min_interval_px = 1e6;
+  DepthMapper random_start(c.camera, options);
+  random_start.InitializeKeyframe(c.keyframe_image, c.edges.trace);
+  const FrameUpdateStats first = random_start.UpdateWithFrame(c.image, c.cur_from_ref, c.lines);
+  EXPECT_GT(first.line_attempts, 1000);
+  EXPECT_EQ(first.line_narrow_prior, 0);
+  options.line_stereo_min_interval_px = -1.0;
+  EXPECT_THROW(DepthMapper(c.camera, options), std::invalid_argument);
+}
+
 TEST(DepthMapperTest, TheStereoPassDoesNotDependOnItsThreads) {
   // mapping.num_threads runs the stereo pass in stripes on OpenCV's thread pool; every pixel's
   // search and fusion is its own, so the map and the counters are the same bit for bit. Two

@@ -54,6 +54,7 @@ void ExpectExtras(const OdometryConfig& config, bool on, const std::string& name
   EXPECT_EQ(config.mapping.line_stereo_estimated_line_noise, on);
   // Off in every config: the paper's behaviour paid on the development set.
   EXPECT_FALSE(config.mapping.line_stereo_prior_interval);
+  EXPECT_EQ(config.mapping.line_stereo_min_interval_px, 0.0);
   EXPECT_EQ(config.tracking.problem.weighting.line_noise, NoiseSource::kFixed);
   // The paper's 3D line regularisation is one of the things the default leaves out.
   EXPECT_EQ(config.mapping.line_regularization, !on);
