@@ -62,6 +62,38 @@ Eigen::Matrix3d InverseLeftJacobianSO3(const Eigen::Vector3d& w) {
   return Eigen::Matrix3d::Identity() - 0.5 * w_hat + coefficient * w_hat * w_hat;
 }
 
+Matrix6d InverseLeftJacobianSE3(const Vector6d& twist) {
+  const Eigen::Matrix3d v = Hat(twist.head<3>());
+  const Eigen::Matrix3d w = Hat(twist.tail<3>());
+  const double a = twist.tail<3>().norm();
+  const double a2 = a * a;
+  // Q's coefficients; their closed forms cancel catastrophically for small angles (the second
+  // one as 1/a^4), so their Taylor series are used below 0.05 rad (truncation below 1e-13).
+  double c1, c2, c3;
+  if (a < 0.05) {
+    c1 = 1.0 / 6.0 - a2 / 120.0 + a2 * a2 / 5040.0;
+    c2 = 1.0 / 24.0 - a2 / 720.0 + a2 * a2 / 40320.0;
+    c3 = 1.0 / 120.0 - a2 / 2520.0 + a2 * a2 / 120960.0;
+  } else {
+    const double s = std::sin(a);
+    const double c = std::cos(a);
+    c1 = (a - s) / (a2 * a);
+    c2 = (a2 + 2.0 * c - 2.0) / (2.0 * a2 * a2);
+    c3 = (2.0 * a - 3.0 * s + a * c) / (2.0 * a2 * a2 * a);
+  }
+  const Eigen::Matrix3d wv = w * v;
+  const Eigen::Matrix3d vw = v * w;
+  const Eigen::Matrix3d wvw = wv * w;
+  const Eigen::Matrix3d q = 0.5 * v + c1 * (wv + vw + wvw) + c2 * (w * wv + vw * w - 3.0 * wvw) +
+                            c3 * (wvw * w + w * wvw);
+  const Eigen::Matrix3d inverse_w = InverseLeftJacobianSO3(twist.tail<3>());
+  Matrix6d inverse = Matrix6d::Zero();
+  inverse.topLeftCorner<3, 3>() = inverse_w;
+  inverse.bottomRightCorner<3, 3>() = inverse_w;
+  inverse.topRightCorner<3, 3>() = -inverse_w * q * inverse_w;
+  return inverse;
+}
+
 SE3 SE3::Exp(const Vector6d& twist) {
   const Eigen::Vector3d v = twist.head<3>();
   const Eigen::Vector3d w = twist.tail<3>();

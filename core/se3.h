@@ -26,6 +26,10 @@ Eigen::Vector3d LogSO3(const Eigen::Matrix3d& rotation);
 // Left Jacobian of SO(3), V(w) above; its inverse.
 Eigen::Matrix3d LeftJacobianSO3(const Eigen::Vector3d& w);
 Eigen::Matrix3d InverseLeftJacobianSO3(const Eigen::Vector3d& w);
+// Inverse of the left Jacobian of SE(3) for a twist (v; w) (Barfoot, eqs. 7.86 and 7.95):
+//   J^-1 = [Jw^-1, -Jw^-1 Q(v, w) Jw^-1; 0, Jw^-1],
+// so that Log(Exp(e) Exp(xi)) = xi + J^-1(xi) e + O(|e|^2).
+Matrix6d InverseLeftJacobianSE3(const Vector6d& twist);
 
 // A rigid transform b_from_a: p_b = R p_a + t. Rotation stored as a unit quaternion.
 class SE3 {

@@ -306,7 +306,9 @@ void Odometry::PollWindowedBA() {
 
 void Odometry::ApplyWindowedBA(const WindowedBAResult& result) {
   ++stats_.windowed_ba_windows;
-  windowed_ba_times_ms_.push_back(1e3 * (result.build_seconds + result.solve_seconds));
+  windowed_ba_times_ms_.push_back(
+      1e3 * (result.build_seconds + result.solve_seconds + result.marginalize_seconds));
+  if (result.num_prior_keyframes > 0) ++stats_.windowed_ba_prior_windows;
   windowed_ba_points_.push_back(static_cast<double>(result.points.size()));
   windowed_ba_iterations_.push_back(result.summary.iterations);
   windowed_ba_outlier_targets_.push_back(static_cast<double>(result.num_outlier_targets));

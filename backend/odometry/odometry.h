@@ -84,12 +84,14 @@ struct OdometryStatistics {
   int line_term_drops = 0;     // frames whose line term the consensus check dropped
   int line_term_withheld = 0;  // frames tracked without it (random_map_warmup_updates)
   // backend.windowed_ba: windows solved, applied (moved the keyframe poses), solves that threw,
-  // depth-correction jobs sent to the mapping thread and the hypotheses they shifted.
+  // depth-correction jobs sent to the mapping thread and the hypotheses they shifted, windows
+  // solved with a marginalisation prior (marginalize).
   int windowed_ba_windows = 0;
   int windowed_ba_applied = 0;
   int windowed_ba_failures = 0;
   int windowed_ba_idepth_jobs = 0;
   int windowed_ba_idepths_corrected = 0;
+  int windowed_ba_prior_windows = 0;
 };
 
 class Odometry {

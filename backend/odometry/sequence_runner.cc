@@ -546,6 +546,7 @@ SequenceRunResult SequenceRunner::Run() {
     ba["outlier_targets_median"] = Median(odometry.WindowedBAOutlierTargets());
     ba["idepth_jobs"] = stats.windowed_ba_idepth_jobs;
     ba["idepths_corrected"] = stats.windowed_ba_idepths_corrected;
+    ba["prior_windows"] = stats.windowed_ba_prior_windows;
     Trajectory keyframes_ba;
     std::map<int, SE3> final_world_from_kf;
     for (const KeyframePoseRecord& record : odometry.WindowedBAKeyframePoses()) {

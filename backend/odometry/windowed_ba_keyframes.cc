@@ -65,6 +65,7 @@ void WindowedBAKeyframes::Clear() {
   for (const Keyframe& keyframe : keyframes_) departed_.push_back(keyframe.record);
   keyframes_.clear();
   submitted_.clear();
+  prior_.reset();
 }
 
 std::vector<WindowedBAPoint> ObservedWindowPoints(const SemiDenseDepthMap& map) {
@@ -106,6 +107,7 @@ bool WindowedBAKeyframes::Ready() const {
 WindowedBAWindow WindowedBAKeyframes::MakeWindow() const {
   WindowedBAWindow window;
   window.camera = camera_;
+  window.prior = prior_;
   std::vector<const Keyframe*> used;
   for (const Keyframe& keyframe : keyframes_) {
     if (keyframe.points != nullptr) used.push_back(&keyframe);
@@ -208,6 +210,7 @@ bool WindowedBAKeyframes::Apply(const WindowedBAResult& result, int corrections_
     }
     keyframe.points = std::move(points);
   }
+  if (result.prior != nullptr) prior_ = result.prior;
   return true;
 }
 

@@ -65,8 +65,8 @@ class WindowedBAKeyframes {
                    const cv::Mat& image, const std::vector<LineSegment>& segments,
                    const std::vector<int>& previous_segment,
                    const AffineBrightness& brightness_from_previous);
-  // Forgets every keyframe (their records move to Departed()), e.g. after a re-initialisation
-  // at an extrapolated pose.
+  // Forgets every keyframe (their records move to Departed()) and the prior, e.g. after a
+  // re-initialisation at an extrapolated pose.
   void Clear();
   // The points of keyframe `id` from its depth map (observed hypotheses with a positive
   // variance); false when `id` is not recorded or the map's size is not the camera's.
@@ -80,7 +80,8 @@ class WindowedBAKeyframes {
   // Remembers the poses and points of a submitted snapshot under its sequence number.
   void Remember(long sequence, const WindowedBAWindow& window);
   // Applies a result of the remembered snapshot `result.sequence` (see above) when its solve
-  // produced poses and did not raise the cost. Returns false (and changes nothing) otherwise.
+  // produced poses and did not raise the cost; its prior (if any) goes with the next snapshots.
+  // Returns false (and changes nothing) otherwise.
   // Forgets that snapshot and every older one. `corrections_of` (may be null) receives the
   // inverse-depth corrections of keyframe `corrections_id`'s optimised points.
   bool Apply(const WindowedBAResult& result, int corrections_id,
@@ -111,6 +112,9 @@ class WindowedBAKeyframes {
   std::deque<Keyframe> keyframes_;  // oldest first
   int next_line_id_ = 0;
   std::map<long, Snapshot> submitted_;
+  // The prior the last applied result left (WindowedBAOptions::marginalize), given to the next
+  // snapshots; null: none.
+  std::shared_ptr<const WindowedBAPrior> prior_;
   std::vector<KeyframePoseRecord> departed_;
 };
 

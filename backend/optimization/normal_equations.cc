@@ -53,7 +53,9 @@ NormalEquations::NormalEquations(const LeastSquaresProblem& problem) : problem_(
   gradient_.resize(dimension_);
 }
 
-bool NormalEquations::Linearize(double* cost) {
+bool NormalEquations::Linearize(double* cost) { return LinearizeBlocks(nullptr, cost); }
+
+bool NormalEquations::LinearizeBlocks(const std::vector<int>* residual_blocks, double* cost) {
   const auto& blocks = problem_.parameter_blocks();
   for (size_t i = 0; i < blocks.size(); ++i) {
     if (tangent_offset_[i] < 0) continue;
@@ -67,128 +69,136 @@ bool NormalEquations::Linearize(double* cost) {
   hessian_.setZero();
   gradient_.setZero();
   double total_cost = 0.0;
-  const auto& residual_blocks = problem_.residual_blocks();
-  for (size_t b = 0; b < residual_blocks.size(); ++b) {
-    const LeastSquaresProblem::ResidualBlock& block = residual_blocks[b];
-    const int rows = block.cost_function->num_residuals();
-    const int num_blocks = static_cast<int>(block.parameter_block_indices.size());
-    const PoseTangentCostFunction* pose_tangent = pose_tangent_[b];
-    if (pose_tangent != nullptr) {
-      double* jacobian = tangent_jacobian_[block.parameter_block_indices[0]].data();
-      if (!pose_tangent->EvaluatePoseTangent(block.parameters.data(), residuals_.data(),
-                                             jacobian)) {
-        return false;
-      }
-    } else {
-      for (int k = 0; k < num_blocks; ++k) {
-        const int index = block.parameter_block_indices[k];
-        jacobian_pointers_[k] =
-            tangent_offset_[index] >= 0 ? ambient_jacobian_[index].data() : nullptr;
-      }
-      if (!block.cost_function->Evaluate(block.parameters.data(), residuals_.data(),
-                                         jacobian_pointers_.data())) {
-        return false;
-      }
+  if (residual_blocks == nullptr) {
+    for (size_t b = 0; b < problem_.residual_blocks().size(); ++b) {
+      if (!AddResidualBlock(static_cast<int>(b), &total_cost)) return false;
     }
-    double sq_norm = 0.0;
-    for (int r = 0; r < rows; ++r) sq_norm += residuals_[r] * residuals_[r];
-
-    // Robust correction of a LossFunction (Ceres' Corrector; equations: gauss_newton_solver.h).
-    double residual_scaling = 1.0;
-    double jacobian_scaling = 1.0;
-    double alpha_sq_norm = 0.0;
-    if (block.loss_function != nullptr) {
-      double rho[3];
-      block.loss_function->Evaluate(sq_norm, rho);
-      total_cost += 0.5 * rho[0];
-      if (rho[1] <= 0.0) continue;  // a fully down-weighted block adds nothing
-      const double sqrt_rho1 = std::sqrt(rho[1]);
-      jacobian_scaling = sqrt_rho1;
-      residual_scaling = sqrt_rho1;
-      if (sq_norm > 0.0 && rho[2] > 0.0) {
-        const double alpha = 1.0 - std::sqrt(1.0 + 2.0 * sq_norm * rho[2] / rho[1]);
-        residual_scaling = sqrt_rho1 / (1.0 - alpha);
-        alpha_sq_norm = alpha / sq_norm;
-      }
-    } else {
-      total_cost += 0.5 * sq_norm;
+  } else {
+    for (const int b : *residual_blocks) {
+      if (!AddResidualBlock(b, &total_cost)) return false;
     }
+  }
+  hessian_.triangularView<Eigen::StrictlyLower>() = hessian_.transpose();
+  *cost = total_cost;
+  return true;
+}
 
-    // Tangent-space Jacobians: J_tangent = J_ambient * PlusJacobian.
-    int variable_blocks = 0;
-    int last_variable = -1;
+bool NormalEquations::AddResidualBlock(int b, double* total_cost) {
+  const LeastSquaresProblem::ResidualBlock& block = problem_.residual_blocks()[b];
+  const int rows = block.cost_function->num_residuals();
+  const int num_blocks = static_cast<int>(block.parameter_block_indices.size());
+  const PoseTangentCostFunction* pose_tangent = pose_tangent_[b];
+  if (pose_tangent != nullptr) {
+    double* jacobian = tangent_jacobian_[block.parameter_block_indices[0]].data();
+    if (!pose_tangent->EvaluatePoseTangent(block.parameters.data(), residuals_.data(), jacobian)) {
+      return false;
+    }
+  } else {
     for (int k = 0; k < num_blocks; ++k) {
       const int index = block.parameter_block_indices[k];
-      if (tangent_offset_[index] < 0) continue;
-      ++variable_blocks;
-      last_variable = index;
-      const int ambient = problem_.parameter_blocks()[index].size;
-      const int tangent = problem_.parameter_blocks()[index].TangentSize();
-      Eigen::Map<RowMajorMatrix> jac_tangent(tangent_jacobian_[index].data(), rows, tangent);
-      if (pose_tangent == nullptr) {
-        Eigen::Map<const RowMajorMatrix> plus(plus_jacobian_[index].data(), ambient, tangent);
-        Eigen::Map<const RowMajorMatrix> jac_ambient(ambient_jacobian_[index].data(), rows,
-                                                     ambient);
-        jac_tangent.noalias() = jac_ambient * plus;
-      }
-      if (alpha_sq_norm != 0.0) {
-        // J <- J - alpha/s r (r^T J).
-        Eigen::Map<const Eigen::VectorXd> r(residuals_.data(), rows);
-        const Eigen::RowVectorXd r_dot_j = r.transpose() * jac_tangent;
-        jac_tangent.noalias() -= (alpha_sq_norm * r) * r_dot_j;
-      }
+      jacobian_pointers_[k] =
+          tangent_offset_[index] >= 0 ? ambient_jacobian_[index].data() : nullptr;
     }
+    if (!block.cost_function->Evaluate(block.parameters.data(), residuals_.data(),
+                                       jacobian_pointers_.data())) {
+      return false;
+    }
+  }
+  double sq_norm = 0.0;
+  for (int r = 0; r < rows; ++r) sq_norm += residuals_[r] * residuals_[r];
 
-    if (variable_blocks == 1) {
-      // One variable block (the tracking problems): H_bb += s^2 J^T J, g_b += s J^T (rs r) as
-      // block products.
-      const int offset = tangent_offset_[last_variable];
-      const int tangent = problem_.parameter_blocks()[last_variable].TangentSize();
-      Eigen::Map<const RowMajorMatrix> jac(tangent_jacobian_[last_variable].data(), rows, tangent);
+  // Robust correction of a LossFunction (Ceres' Corrector; equations: gauss_newton_solver.h).
+  double residual_scaling = 1.0;
+  double jacobian_scaling = 1.0;
+  double alpha_sq_norm = 0.0;
+  if (block.loss_function != nullptr) {
+    double rho[3];
+    block.loss_function->Evaluate(sq_norm, rho);
+    *total_cost += 0.5 * rho[0];
+    if (rho[1] <= 0.0) return true;  // a fully down-weighted block adds nothing
+    const double sqrt_rho1 = std::sqrt(rho[1]);
+    jacobian_scaling = sqrt_rho1;
+    residual_scaling = sqrt_rho1;
+    if (sq_norm > 0.0 && rho[2] > 0.0) {
+      const double alpha = 1.0 - std::sqrt(1.0 + 2.0 * sq_norm * rho[2] / rho[1]);
+      residual_scaling = sqrt_rho1 / (1.0 - alpha);
+      alpha_sq_norm = alpha / sq_norm;
+    }
+  } else {
+    *total_cost += 0.5 * sq_norm;
+  }
+
+  // Tangent-space Jacobians: J_tangent = J_ambient * PlusJacobian.
+  int variable_blocks = 0;
+  int last_variable = -1;
+  for (int k = 0; k < num_blocks; ++k) {
+    const int index = block.parameter_block_indices[k];
+    if (tangent_offset_[index] < 0) continue;
+    ++variable_blocks;
+    last_variable = index;
+    const int ambient = problem_.parameter_blocks()[index].size;
+    const int tangent = problem_.parameter_blocks()[index].TangentSize();
+    Eigen::Map<RowMajorMatrix> jac_tangent(tangent_jacobian_[index].data(), rows, tangent);
+    if (pose_tangent == nullptr) {
+      Eigen::Map<const RowMajorMatrix> plus(plus_jacobian_[index].data(), ambient, tangent);
+      Eigen::Map<const RowMajorMatrix> jac_ambient(ambient_jacobian_[index].data(), rows, ambient);
+      jac_tangent.noalias() = jac_ambient * plus;
+    }
+    if (alpha_sq_norm != 0.0) {
+      // J <- J - alpha/s r (r^T J).
       Eigen::Map<const Eigen::VectorXd> r(residuals_.data(), rows);
-      hessian_.block(offset, offset, tangent, tangent)
-          .selfadjointView<Eigen::Upper>()
-          .rankUpdate(jac.transpose(), jacobian_scaling * jacobian_scaling);
-      gradient_.segment(offset, tangent).noalias() +=
-          (jacobian_scaling * residual_scaling) * (jac.transpose() * r);
-      continue;
+      const Eigen::RowVectorXd r_dot_j = r.transpose() * jac_tangent;
+      jac_tangent.noalias() -= (alpha_sq_norm * r) * r_dot_j;
     }
+  }
 
-    // Accumulate the upper triangle of H and g row by row through a dense tangent row, visiting
-    // only the columns of this block's variable parameter blocks (sorted, so that every entry
-    // receives the same sums in the same order as a sweep over all columns would give it).
-    columns_.clear();
+  if (variable_blocks == 1) {
+    // One variable block (the tracking problems): H_bb += s^2 J^T J, g_b += s J^T (rs r) as
+    // block products.
+    const int offset = tangent_offset_[last_variable];
+    const int tangent = problem_.parameter_blocks()[last_variable].TangentSize();
+    Eigen::Map<const RowMajorMatrix> jac(tangent_jacobian_[last_variable].data(), rows, tangent);
+    Eigen::Map<const Eigen::VectorXd> r(residuals_.data(), rows);
+    hessian_.block(offset, offset, tangent, tangent)
+        .selfadjointView<Eigen::Upper>()
+        .rankUpdate(jac.transpose(), jacobian_scaling * jacobian_scaling);
+    gradient_.segment(offset, tangent).noalias() +=
+        (jacobian_scaling * residual_scaling) * (jac.transpose() * r);
+    return true;
+  }
+
+  // Accumulate the upper triangle of H and g row by row through a dense tangent row, visiting
+  // only the columns of this block's variable parameter blocks (sorted, so that every entry
+  // receives the same sums in the same order as a sweep over all columns would give it).
+  columns_.clear();
+  for (int k = 0; k < num_blocks; ++k) {
+    const int index = block.parameter_block_indices[k];
+    const int offset = tangent_offset_[index];
+    if (offset < 0) continue;
+    const int tangent = problem_.parameter_blocks()[index].TangentSize();
+    for (int c = 0; c < tangent; ++c) columns_.push_back(offset + c);
+  }
+  std::sort(columns_.begin(), columns_.end());
+  const int num_columns = static_cast<int>(columns_.size());
+  for (int r = 0; r < rows; ++r) {
+    for (const int column : columns_) row_[column] = 0.0;
     for (int k = 0; k < num_blocks; ++k) {
       const int index = block.parameter_block_indices[k];
       const int offset = tangent_offset_[index];
       if (offset < 0) continue;
       const int tangent = problem_.parameter_blocks()[index].TangentSize();
-      for (int c = 0; c < tangent; ++c) columns_.push_back(offset + c);
+      const double* jac_row = tangent_jacobian_[index].data() + r * tangent;
+      for (int c = 0; c < tangent; ++c) row_[offset + c] += jacobian_scaling * jac_row[c];
     }
-    std::sort(columns_.begin(), columns_.end());
-    const int num_columns = static_cast<int>(columns_.size());
-    for (int r = 0; r < rows; ++r) {
-      for (const int column : columns_) row_[column] = 0.0;
-      for (int k = 0; k < num_blocks; ++k) {
-        const int index = block.parameter_block_indices[k];
-        const int offset = tangent_offset_[index];
-        if (offset < 0) continue;
-        const int tangent = problem_.parameter_blocks()[index].TangentSize();
-        const double* jac_row = tangent_jacobian_[index].data() + r * tangent;
-        for (int c = 0; c < tangent; ++c) row_[offset + c] += jacobian_scaling * jac_row[c];
-      }
-      const double residual = residual_scaling * residuals_[r];
-      for (int i = 0; i < num_columns; ++i) {
-        const int a = columns_[i];
-        const double ja = row_[a];
-        if (ja == 0.0) continue;
-        gradient_[a] += ja * residual;
-        for (int j = i; j < num_columns; ++j) hessian_(a, columns_[j]) += ja * row_[columns_[j]];
-      }
+    const double residual = residual_scaling * residuals_[r];
+    for (int i = 0; i < num_columns; ++i) {
+      const int a = columns_[i];
+      const double ja = row_[a];
+      if (ja == 0.0) continue;
+      gradient_[a] += ja * residual;
+      for (int j = i; j < num_columns; ++j) hessian_(a, columns_[j]) += ja * row_[columns_[j]];
     }
   }
-  hessian_.triangularView<Eigen::StrictlyLower>() = hessian_.transpose();
-  *cost = total_cost;
   return true;
 }
 

@@ -33,12 +33,18 @@ class NormalEquations {
 
   // Evaluates cost, H and g at the current parameters; false when an evaluation fails.
   bool Linearize(double* cost);
+  // The same over the given residual blocks only (indices into the problem's residual_blocks();
+  // nullptr: all), e.g. the rows a marginalisation removes.
+  bool LinearizeBlocks(const std::vector<int>* residual_blocks, double* cost);
   // x <- Plus(x, delta) for every variable block, keeping the previous values in `backup`.
   bool ApplyStep(const Eigen::VectorXd& delta, std::vector<double>* backup);
   void Restore(const std::vector<double>& backup);
   double ParameterNorm() const;
 
  private:
+  // Adds residual block `b`'s cost to *total_cost and its rows to H and g.
+  bool AddResidualBlock(int b, double* total_cost);
+
   const LeastSquaresProblem& problem_;
   int dimension_ = 0;
   std::vector<int> tangent_offset_;                 // per parameter block, -1 if constant

@@ -81,6 +81,10 @@ struct WindowedBAOptions {
   // occlusions, a wrong depth): such rows pull the poses and their robust loss is not convex.
   // 0 = off.
   double outlier_energy_factor = 0.0;
+  // What leaves the window (docs/windowed_ba.md): true marginalises the oldest keyframe of a full
+  // window into a prior on the poses of the others for the next window (DSO; marginalization.h);
+  // false is a fixed lag (a leaving keyframe keeps its last pose, its rows are forgotten).
+  bool marginalize = false;
   // sigma_b of the baseline prior (the scale gauge) as a fraction of the baseline. Without
   // inverse-depth priors any value > 0 gives the same optimum (the rows are scale-invariant);
   // 1e-2 keeps the system conditioned.
@@ -134,6 +138,9 @@ struct WindowedBAOptions {
     v.Field("outlier_energy_factor", &outlier_energy_factor,
             "A photometric target whose energy at the input exceeds this^2 times the window's "
             "median is left out; 0 = off (default 0).");
+    v.Field("marginalize", &marginalize,
+            "Marginalise the keyframe leaving a full window into a prior on the others' poses "
+            "(DSO); false: fixed lag (default false).");
     v.Field("baseline_prior_sigma_ratio", &baseline_prior_sigma_ratio,
             "sigma of the scale prior as a fraction of the baseline.");
     v.Section("weighting", &weighting, "Weighting of the residual families and robust loss.");

@@ -13,6 +13,7 @@
 #include "residuals/baseline_prior_residual.h"
 #include "residuals/host_target_photometric_residual.h"
 #include "residuals/host_target_point_to_line_residual.h"
+#include "residuals/pose_prior_residual.h"
 #include "residuals/se3_manifold.h"
 
 namespace pldvo {
@@ -38,6 +39,9 @@ class PhotometricLineWindowBuilder : public WindowedBAProblemBuilder {
  private:
   // Holds the scale: the baseline prior of the header, or the second pose constant.
   void AddScaleGauge(WindowedBAProblem* problem) const;
+  // The prior's residual block on the window keyframes it constrains (none when the window
+  // still holds a keyframe it has marginalised, or it constrains none of them).
+  void AddPrior(const WindowedBAWindow& window, WindowedBAProblem* problem) const;
 
   WindowedBAOptions options_;
   bool loss_in_problem_;
@@ -88,6 +92,28 @@ void PhotometricLineWindowBuilder::AddScaleGauge(WindowedBAProblem* out) const {
       std::unique_ptr<ceres::CostFunction>(BaselinePriorResidual::Create(
           out->baseline, options_.baseline_prior_sigma_ratio * out->baseline)),
       nullptr, {out->poses[0].data(), out->poses[partner].data()});
+}
+
+void PhotometricLineWindowBuilder::AddPrior(const WindowedBAWindow& window,
+                                            WindowedBAProblem* out) const {
+  const WindowedBAPrior& prior = *window.prior;
+  std::vector<int> ids;
+  for (const int index : out->keyframe_indices) {
+    const int id = window.keyframes[index].id;
+    if (id <= prior.marginalized_through_id) return;
+    ids.push_back(id);
+  }
+  WindowedBAPrior kept;
+  if (!KeepKeyframes(prior, ids, &kept)) return;
+  std::vector<double*> poses;
+  for (const int id : kept.keyframe_ids) {
+    poses.push_back(out->poses[std::find(ids.begin(), ids.end(), id) - ids.begin()].data());
+  }
+  if (!(kept.information.diagonal().maxCoeff() > 0.0)) return;
+  out->prior_block = out->problem.AddResidualBlock(
+      std::make_unique<PosePriorResidual>(kept.cam_from_world, kept.information, kept.gradient),
+      nullptr, poses);
+  out->num_prior_keyframes = static_cast<int>(poses.size());
 }
 
 WindowedBAProblem PhotometricLineWindowBuilder::Build(const WindowedBAWindow& window) const {
@@ -143,6 +169,7 @@ WindowedBAProblem PhotometricLineWindowBuilder::Build(const WindowedBAWindow& wi
         nullptr, {out.brightness[k].data()});
   }
   AddScaleGauge(&out);
+  if (options_.marginalize && window.prior != nullptr) AddPrior(window, &out);
 
   ceres::LossFunction* loss = nullptr;
   if (std::unique_ptr<ceres::LossFunction> made = MakeLossFunction(options_.weighting)) {
@@ -270,29 +297,32 @@ WindowedBAProblem PhotometricLineWindowBuilder::Build(const WindowedBAWindow& wi
     problem.SetParameterBlockEliminated(idepth);
     if (options_.idepth_prior_scale > 0.0) {
       const double sigma = options_.idepth_prior_scale * std::sqrt(point.idepth_var);
-      problem.AddResidualBlock(
+      const int block = problem.AddResidualBlock(
           std::make_unique<ceres::NormalPrior>(ceres::Matrix::Constant(1, 1, 1.0 / sigma),
                                                ceres::Vector::Constant(1, point.idepth)),
           nullptr, {idepth});
+      if (host == 0) out.oldest_host_blocks.push_back(block);
     }
     kept_points.push_back(selected);
     for (PendingPhotometric& pending : pending_photometric) {
       out.num_photometric_rows += static_cast<int>(pending.pattern.size());
       ++out.num_photometric_blocks;
-      problem.AddResidualBlock(
+      const int block = problem.AddResidualBlock(
           std::unique_ptr<ceres::CostFunction>(HostTargetPhotometricResidual::Create(
               *keyframe(pending.target).pyramid, 0, camera, std::move(pending.pattern), loss_inside,
               options_.interpolation)),
           loss_outside,
           {out.poses[host].data(), out.poses[pending.target].data(), idepth,
            out.brightness[host].data(), out.brightness[pending.target].data()});
+      if (host == 0) out.oldest_host_blocks.push_back(block);
     }
     for (const PendingLine& pending : pending_lines) {
       ++out.num_line_rows;
-      problem.AddResidualBlock(
+      const int block = problem.AddResidualBlock(
           std::unique_ptr<ceres::CostFunction>(HostTargetPointToLineResidual::Create(
               camera, point.pixel, pending.line, pending.sqrt_info, loss_inside)),
           loss_outside, {out.poses[host].data(), out.poses[pending.target].data(), idepth});
+      if (host == 0) out.oldest_host_blocks.push_back(block);
     }
   }
   out.points = std::move(kept_points);

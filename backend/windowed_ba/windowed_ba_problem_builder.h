@@ -14,7 +14,10 @@
 //     a line observation in another window keyframe, sqrt_info from Sigma_g (eq. 6);
 //   - inverse-depth prior: N(input, (idepth_prior_scale^2) V) on each point (see the options);
 //   - brightness prior: N(input, diag(sigma_a^2, sigma_b^2)) on every keyframe's {a, b} but the
-//     oldest's (with brightness affine).
+//     oldest's (with brightness affine);
+//   - with WindowedBAOptions::marginalize, the window's prior (windowed_ba_prior.h) on the poses
+//     of its keyframes, a PosePriorResidual, unless the window still holds a keyframe the prior
+//     has marginalised.
 //
 // Gauge. Monocular BA is invariant to a similarity of the world (7 DOF), the photometric rows
 // also to an affine change of the radiance (2 DOF: every a_k + c, and b_k - e^{a_k} beta).
@@ -63,12 +66,17 @@ struct WindowedBAProblem {
   int baseline_keyframe_a = -1;
   int baseline_keyframe_b = -1;
   double baseline = 0.0;
+  // Marginalisation (marginalization.h): the residual blocks of the points hosted in the oldest
+  // keyframe (photometric, point-to-line, inverse-depth prior) and the prior's block (-1: none).
+  std::vector<int> oldest_host_blocks;
+  int prior_block = -1;
   // Statistics.
   int num_candidates = 0;  // selected by SelectWindowPoints, before the min_targets check
   int num_photometric_blocks = 0;
   int num_outlier_targets = 0;  // photometric targets left out by outlier_energy_factor
   int num_photometric_rows = 0;
   int num_line_rows = 0;
+  int num_prior_keyframes = 0;  // window keyframes the prior constrains
 };
 
 class WindowedBAProblemBuilder {

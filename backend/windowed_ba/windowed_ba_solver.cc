@@ -4,12 +4,14 @@
 #include <ceres/problem.h>
 
 #include <chrono>
+#include <cmath>
 #include <memory>
 #include <stdexcept>
 
 #include "backend/optimization/bundle_adjustment_options.h"
 #include "backend/optimization/ceres_solver.h"
 #include "backend/optimization/gauss_newton_solver.h"
+#include "backend/windowed_ba/marginalization.h"
 #include "residuals/se3_manifold.h"
 
 namespace pldvo {
@@ -77,6 +79,7 @@ WindowedBAResult RunWindowedBA(const WindowedBAWindow& window, const WindowedBAO
   result.num_photometric_rows = problem.num_photometric_rows;
   result.num_line_rows = problem.num_line_rows;
   result.num_outlier_targets = problem.num_outlier_targets;
+  result.num_prior_keyframes = problem.num_prior_keyframes;
   const auto solve_start = std::chrono::steady_clock::now();
   result.summary = SolveWindowedBAProblem(options, &problem);
   result.solve_seconds = SecondsSince(solve_start);
@@ -91,6 +94,18 @@ WindowedBAResult RunWindowedBA(const WindowedBAWindow& window, const WindowedBAO
     const WindowedBAProblemPoint& point = problem.points[i];
     result.points.push_back({window.keyframes[problem.keyframe_indices[point.host]].id,
                              point.point_index, problem.idepths[i]});
+  }
+  // The next window drops the oldest keyframe of a full one.
+  const int n = static_cast<int>(problem.keyframe_indices.size());
+  if (options.marginalize && n == options.window && std::isfinite(result.summary.final_cost)) {
+    const auto marginalize_start = std::chrono::steady_clock::now();
+    std::vector<int> ids;
+    for (const WindowedBAResultKeyframe& keyframe : result.keyframes) ids.push_back(keyframe.id);
+    WindowedBAPrior prior;
+    if (MarginalizeOldestKeyframe(ids, &problem, &prior)) {
+      result.prior = std::make_shared<const WindowedBAPrior>(std::move(prior));
+    }
+    result.marginalize_seconds = SecondsSince(marginalize_start);
   }
   return result;
 }

@@ -12,6 +12,7 @@
 
 #include <ceres/solver.h>
 
+#include <memory>
 #include <vector>
 
 #include "backend/optimization/solver.h"
@@ -50,6 +51,12 @@ struct WindowedBAResult {
   int num_outlier_targets = 0;  // WindowedBAProblem::num_outlier_targets
   double build_seconds = 0.0;
   double solve_seconds = 0.0;
+  // With WindowedBAOptions::marginalize and a full window: the prior for the next window (its
+  // oldest keyframe marginalised), else null. num_prior_keyframes: the keyframes this window's
+  // own prior constrained (0: none).
+  std::shared_ptr<const WindowedBAPrior> prior;
+  int num_prior_keyframes = 0;
+  double marginalize_seconds = 0.0;
 };
 
 // Builds the window with the registered builder options.problem_builder and solves it. Throws

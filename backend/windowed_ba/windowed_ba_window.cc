@@ -50,6 +50,7 @@ void CheckWindowedBAWindow(const WindowedBAWindow& window) {
       }
     }
   }
+  if (window.prior != nullptr) CheckWindowedBAPrior(*window.prior);
 }
 
 }  // namespace pldvo

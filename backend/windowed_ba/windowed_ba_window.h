@@ -12,6 +12,7 @@
 #include <memory>
 #include <vector>
 
+#include "backend/windowed_ba/windowed_ba_prior.h"
 #include "core/image_pyramid.h"
 #include "core/pinhole_camera.h"
 #include "core/se3.h"
@@ -48,12 +49,15 @@ struct WindowedBAWindow {
   PinholeCamera camera;
   // Oldest first, strictly increasing ids. Only the newest WindowedBAOptions::window are used.
   std::vector<WindowedBAKeyframe> keyframes;
+  // What earlier windows left when their oldest keyframes left (WindowedBAOptions::marginalize);
+  // null: none.
+  std::shared_ptr<const WindowedBAPrior> prior;
 };
 
 // Throws std::invalid_argument naming the keyframe / point when the window is malformed (invalid
 // camera, fewer than 2 keyframes, ids not increasing, missing pyramid or one whose level 0
 // differs from the camera, non-finite pose, a point with non-finite pixel or non-positive
-// idepth / idepth_var, a line observation whose line is not normalised).
+// idepth / idepth_var, a line observation whose line is not normalised, a malformed prior).
 void CheckWindowedBAWindow(const WindowedBAWindow& window);
 
 }  // namespace pldvo

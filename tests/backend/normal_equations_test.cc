@@ -87,8 +87,10 @@ struct RowsSetup {
 };
 
 // H, g and the cost of photometric and point-to-line rows at a pose near the truth; with
-// `hide_tangent` through Evaluate() only.
-Linearization LinearizeRows(const RowsSetup& setup, bool hide_tangent) {
+// `hide_tangent` through Evaluate() only; `blocks`: only those residual blocks (0 photometric,
+// 1 point-to-line; nullptr: both).
+Linearization LinearizeRows(const RowsSetup& setup, bool hide_tangent,
+                            const std::vector<int>* blocks = nullptr) {
   const PinholeCamera camera = TestCamera();
   const SE3 truth = TestCurFromRef();
   const ImagePyramid pyramid(testing_utils::SampleImage(camera, testing_utils::SmoothIntensity), 1);
@@ -124,7 +126,7 @@ Linearization LinearizeRows(const RowsSetup& setup, bool hide_tangent) {
   }
   NormalEquations equations(problem);
   Linearization result;
-  EXPECT_TRUE(equations.Linearize(&result.cost));
+  EXPECT_TRUE(equations.LinearizeBlocks(blocks, &result.cost));
   result.hessian = equations.hessian();
   result.gradient = equations.gradient();
   result.pose_tangent_blocks = equations.num_pose_tangent_blocks();
@@ -145,6 +147,26 @@ void ExpectSameLinearization(const RowsSetup& setup, int pose_tangent_blocks) {
             1e-12 * generic.hessian.cwiseAbs().maxCoeff());
   EXPECT_LE((tangent.gradient - generic.gradient).cwiseAbs().maxCoeff(),
             1e-12 * generic.gradient.cwiseAbs().maxCoeff());
+}
+
+// H, g and the cost are sums over the residual blocks: linearising a subset (as a
+// marginalisation does) gives that subset's share.
+TEST(NormalEquationsTest, SubsetsOfBlocksAddUpToTheWhole) {
+  RowsSetup setup;
+  setup.brightness = BrightnessModel::kAffine;
+  setup.brightness_variable = true;
+  setup.block_loss = true;
+  const std::vector<int> photometric = {0}, lines = {1};
+  const Linearization whole = LinearizeRows(setup, false);
+  const Linearization a = LinearizeRows(setup, false, &photometric);
+  const Linearization b = LinearizeRows(setup, false, &lines);
+  ASSERT_GT(a.hessian.norm(), 0.0);
+  ASSERT_GT(b.hessian.norm(), 0.0);
+  EXPECT_LE((a.hessian + b.hessian - whole.hessian).cwiseAbs().maxCoeff(),
+            1e-12 * whole.hessian.cwiseAbs().maxCoeff());
+  EXPECT_LE((a.gradient + b.gradient - whole.gradient).cwiseAbs().maxCoeff(),
+            1e-12 * whole.gradient.cwiseAbs().maxCoeff());
+  EXPECT_NEAR(a.cost + b.cost, whole.cost, 1e-12 * whole.cost);
 }
 
 TEST(NormalEquationsTest, PoseTangentRowsGiveTheGenericHessianAndGradient) {

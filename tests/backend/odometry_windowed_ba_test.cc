@@ -139,6 +139,21 @@ TEST(OdometryWindowedBATest, SolvesAWindowPerKeyframeAndAnchorsTrackingToIt) {
   EXPECT_LT(TranslationDistance(run.keyframes.front().world_from_kf, created[0]), 1e-12);
 }
 
+// marginalize with a window of 3: from the window after the first full one, each window carries
+// the prior its predecessor left (its oldest keyframe marginalised), and every window applies.
+TEST(OdometryWindowedBATest, MarginalisedKeyframesLeaveAPriorForTheNextWindow) {
+  OdometryConfig config = Config(true);
+  config.backend.windowed_ba.window = 3;
+  config.backend.windowed_ba.marginalize = true;
+  const RunResult run = RunSequence(config);
+  for (const OdometryFrameResult& frame : run.frames) EXPECT_TRUE(IsTracked(frame.status));
+  ASSERT_GE(run.stats.windowed_ba_windows, 3);
+  EXPECT_EQ(run.stats.windowed_ba_applied, run.stats.windowed_ba_windows);
+  EXPECT_EQ(run.stats.windowed_ba_failures, 0);
+  // Windows 1 and 2 grow to 3 keyframes; from the third on each has a prior.
+  EXPECT_EQ(run.stats.windowed_ba_prior_windows, run.stats.windowed_ba_windows - 2);
+}
+
 TEST(OdometryWindowedBATest, SynchronousModeRepeatsExactly) {
   const RunResult a = RunSequence(Config(true));
   const RunResult b = RunSequence(Config(true));

@@ -75,6 +75,27 @@ TEST(SO3, LeftJacobianMatchesNumericDerivativeOfExp) {
   }
 }
 
+TEST(SE3, InverseLeftJacobianMatchesNumericDerivativeOfLog) {
+  // Log(Exp(e) Exp(xi)) = xi + J^-1(xi) e to first order; angles on both sides of the switch to
+  // the Taylor series (0.05 rad).
+  std::mt19937 rng(5);
+  std::normal_distribution<double> normal;
+  for (double angle : {0.0, 1e-7, 0.01, 0.049, 0.051, 0.5, 2.5}) {
+    Vector6d xi;
+    xi.head<3>() = 0.3 * DrawVector3(normal, rng);
+    xi.tail<3>() = angle * RandomAxis(rng);
+    const SE3 base = SE3::Exp(xi);
+    Matrix6d numeric;
+    for (int k = 0; k < 6; ++k) {
+      Vector6d e = Vector6d::Zero();
+      e[k] = kStep;
+      numeric.col(k) = ((SE3::Exp(e) * base).Log() - (SE3::Exp(-e) * base).Log()) / (2.0 * kStep);
+    }
+    EXPECT_LT((numeric - InverseLeftJacobianSE3(xi)).norm(), kNumericTolerance)
+        << "angle " << angle;
+  }
+}
+
 TEST(SE3, ExpLogRoundTrip) {
   std::mt19937 rng(4);
   std::normal_distribution<double> normal;
