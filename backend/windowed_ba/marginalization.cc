@@ -1,5 +1,8 @@
 #include "backend/windowed_ba/marginalization.h"
 
+#include <utility>
+#include <vector>
+
 #include "backend/optimization/normal_equations.h"
 #include "residuals/se3_manifold.h"
 
