@@ -1,6 +1,6 @@
 // A Gaussian prior on several poses, linearised at given poses T0_k: the residual whose squared
 // norm / 2 is the quadratic energy a marginalisation leaves behind (DSO, Engel et al. PAMI 2018,
-// Sec. 3.2; backend/windowed_ba/marginalization_prior.h):
+// Sec. 3.2; backend/windowed_ba/marginalization.h, windowed_ba_prior.h):
 //
 //   E(d) = 1/2 d^T H d + b^T d,   d = (d_1; ...; d_K),   d_k = Minus(T_k, T0_k) = Log(T_k T0_k^-1),
 //   r    = S d + s,  with H = V L V^T, S = L^1/2 V^T, s = L^-1/2 V^T b over the eigenvalues
