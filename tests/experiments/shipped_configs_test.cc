@@ -112,6 +112,7 @@ const std::map<std::string, std::function<void(const OdometryConfig&)>>& Cases()
          EXPECT_EQ(c.backend.windowed_ba.max_points, 2000);
          EXPECT_EQ(c.backend.windowed_ba.max_iterations, 20);
          EXPECT_TRUE(c.backend.windowed_ba.lines);
+         EXPECT_EQ(c.backend.windowed_ba.interpolation, ImageInterpolation::kBicubic);
        }},
       {"sdvo",
        [](const OdometryConfig& c) {
