@@ -37,19 +37,13 @@ void SchurComplement(const Eigen::MatrixXd& information, const Eigen::VectorXd& 
   std::vector<int> k_index, m_index;
   for (int i = 0; i < static_cast<int>(keep.size()); ++i)
     (keep[i] ? k_index : m_index).push_back(i);
-  const int nk = static_cast<int>(k_index.size());
   const int nm = static_cast<int>(m_index.size());
-  Eigen::MatrixXd h_kk(nk, nk), h_km(nk, nm), h_mm(nm, nm);
-  Eigen::VectorXd b_k(nk), b_m(nm);
-  for (int i = 0; i < nk; ++i) {
-    b_k(i) = gradient(k_index[i]);
-    for (int j = 0; j < nk; ++j) h_kk(i, j) = information(k_index[i], k_index[j]);
-    for (int j = 0; j < nm; ++j) h_km(i, j) = information(k_index[i], m_index[j]);
-  }
-  for (int i = 0; i < nm; ++i) {
-    b_m(i) = gradient(m_index[i]);
-    for (int j = 0; j < nm; ++j) h_mm(i, j) = information(m_index[i], m_index[j]);
-  }
+  // Eigen 3.4 indexed views gather the kept (k) and marginalised (m) rows and columns.
+  const Eigen::MatrixXd h_kk = information(k_index, k_index);
+  const Eigen::MatrixXd h_km = information(k_index, m_index);
+  const Eigen::MatrixXd h_mm = information(m_index, m_index);
+  const Eigen::VectorXd b_k = gradient(k_index);
+  const Eigen::VectorXd b_m = gradient(m_index);
   if (nm == 0) {
     *kept_information = h_kk;
     *kept_gradient = b_k;
