@@ -27,6 +27,22 @@ inline const ChoiceNames<WindowedBAPattern>& WindowedBAPatternNames() {
   return names;
 }
 
+// What the newest keyframe of a window hosts. The window is solved when the newest keyframe's
+// first map is published: that map is the previous keyframe's propagated into it, so its points
+// repeat the previous keyframe's depths, depth-filter variances and image pairs.
+enum class NewestKeyframePoints {
+  kHost,         // points with inverse-depth priors, as every other keyframe
+  kHostNoPrior,  // points without inverse-depth priors (the priors would count twice)
+  kTargetOnly,   // no points (as in DSO, where a new keyframe's points enter later windows)
+};
+inline const ChoiceNames<NewestKeyframePoints>& NewestKeyframePointsNames() {
+  static const ChoiceNames<NewestKeyframePoints> names = {
+      {"host", NewestKeyframePoints::kHost},
+      {"host_no_prior", NewestKeyframePoints::kHostNoPrior},
+      {"target_only", NewestKeyframePoints::kTargetOnly}};
+  return names;
+}
+
 enum class WindowedBASolver { kCeres, kGaussNewton };
 inline const ChoiceNames<WindowedBASolver>& WindowedBASolverNames() {
   static const ChoiceNames<WindowedBASolver> names = {
@@ -55,6 +71,9 @@ struct WindowedBAOptions {
   WindowedBAPattern pattern = WindowedBAPattern::kDso8;
   // A point enters only if it has photometric rows in at least this many other keyframes.
   int min_targets = 1;
+  // What the newest keyframe hosts; target_only splits max_points over the others. host measured
+  // best on the development set (docs/windowed_ba.md).
+  NewestKeyframePoints newest_keyframe_points = NewestKeyframePoints::kHost;
   // Sampling of the target images (residuals/photometric_residual.h): bilinear (as tracking) or
   // bicubic (exact Jacobian).
   ImageInterpolation interpolation = ImageInterpolation::kBilinear;
@@ -123,6 +142,9 @@ struct WindowedBAOptions {
     v.Choice("pattern", &pattern, WindowedBAPatternNames(),
              "Host pixels per point: single or dso8.");
     v.Field("min_targets", &min_targets, "Other keyframes a point must reproject into (>= 1).");
+    v.Choice("newest_keyframe_points", &newest_keyframe_points, NewestKeyframePointsNames(),
+             "Points of the newest keyframe (its map propagated from the previous one): host "
+             "(with depth priors, default), host_no_prior, or target_only (as in DSO).");
     v.Choice("interpolation", &interpolation, ImageInterpolationNames(),
              "Sampling of the target images: bilinear or bicubic.");
     v.Choice("brightness", &brightness, BrightnessModelNames(),

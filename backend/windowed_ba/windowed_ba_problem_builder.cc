@@ -136,8 +136,10 @@ WindowedBAProblem PhotometricLineWindowBuilder::Build(const WindowedBAWindow& wi
   // Point selection, before any block is added: `idepths` must not reallocate afterwards.
   const bool dso8 = options_.pattern == WindowedBAPattern::kDso8;
   const double pattern_radius = dso8 ? 2.0 : 0.0;
-  const int budget = options_.max_points / n;
-  for (int k = 0; k < n; ++k) {
+  const int hosts =
+      options_.newest_keyframe_points == NewestKeyframePoints::kTargetOnly && n > 1 ? n - 1 : n;
+  const int budget = options_.max_points / hosts;
+  for (int k = 0; k < hosts; ++k) {
     for (const int index : SelectWindowPoints(keyframe(k).points, *keyframe(k).pyramid, budget,
                                               options_.min_gradient, pattern_radius)) {
       out.points.push_back({k, index});
@@ -295,7 +297,10 @@ WindowedBAProblem PhotometricLineWindowBuilder::Build(const WindowedBAWindow& wi
     double* idepth = &out.idepths.back();
     problem.AddParameterBlock(idepth, 1);
     problem.SetParameterBlockEliminated(idepth);
-    if (options_.idepth_prior_scale > 0.0) {
+    const bool prior_counts_twice =
+        n > 1 && host == n - 1 &&
+        options_.newest_keyframe_points == NewestKeyframePoints::kHostNoPrior;
+    if (options_.idepth_prior_scale > 0.0 && !prior_counts_twice) {
       const double sigma = options_.idepth_prior_scale * std::sqrt(point.idepth_var);
       const int block = problem.AddResidualBlock(
           std::make_unique<ceres::NormalPrior>(ceres::Matrix::Constant(1, 1, 1.0 / sigma),

@@ -313,6 +313,46 @@ TEST(WindowedBATest, ProblemHasTheGaugeAndCovarianceWeights) {
 // inverse depths are barely constrained and the solve crawls (docs/windowed_ba.md), stopping
 // 5.4e-4 relative from the input baseline (measured; bound 2e-3, against the prior's sigma of
 // 1e-2 and the inputs' scale error of a few percent).
+// newest_keyframe_points: target_only leaves the newest keyframe (whose map the odometry
+// propagates from the previous one) without points, a target only, and the other keyframes share
+// max_points; host_no_prior keeps its points and drops only their inverse-depth priors. Measured
+// on this 3-keyframe window: hosts 0/1/2 get 45/48/48 points with host, 70/75/0 with target_only.
+TEST(WindowedBATest, NewestKeyframePointsChoosesWhatTheNewestHosts) {
+  WindowedBASimulationOptions simulation_options;
+  simulation_options.num_keyframes = 3;
+  simulation_options.width = 160;
+  simulation_options.height = 120;
+  simulation_options.focal = 131.0;
+  const WindowedBASimulation simulation = SimulateWindowedBAWindow(simulation_options);
+  WindowedBAOptions options;
+  options.window = 3;
+  options.max_points = 150;
+  struct Built {
+    std::vector<int> hosted = std::vector<int>(3, 0);
+    size_t blocks = 0;
+  };
+  auto build = [&](NewestKeyframePoints newest) {
+    options.newest_keyframe_points = newest;
+    const WindowedBAProblem problem =
+        MakeWindowedBAProblemBuilder("windowed_ba", options)->Build(simulation.window);
+    Built built;
+    for (const WindowedBAProblemPoint& point : problem.points) ++built.hosted.at(point.host);
+    built.blocks = problem.problem.residual_blocks().size();
+    std::printf("hosted %d / %d / %d, %zu blocks\n", built.hosted[0], built.hosted[1],
+                built.hosted[2], built.blocks);
+    return built;
+  };
+  const Built host = build(NewestKeyframePoints::kHost);
+  EXPECT_GT(host.hosted[2], 0);
+  const Built no_prior = build(NewestKeyframePoints::kHostNoPrior);
+  EXPECT_EQ(no_prior.hosted, host.hosted);
+  EXPECT_EQ(no_prior.blocks + host.hosted[2], host.blocks);
+  const Built target_only = build(NewestKeyframePoints::kTargetOnly);
+  EXPECT_EQ(target_only.hosted[2], 0);
+  EXPECT_GT(target_only.hosted[0], host.hosted[0]);
+  EXPECT_GT(target_only.hosted[1], host.hosted[1]);
+}
+
 TEST(WindowedBATest, SolveKeepsTheGauge) {
   WindowedBASimulationOptions simulation_options;
   simulation_options.num_keyframes = 3;
