@@ -36,6 +36,16 @@ std::vector<SE3> Poses(const WindowedBAResult& result) {
 
 Eigen::Vector3d Centre(const SE3& cam_from_world) { return cam_from_world.Inverse().translation(); }
 
+// The window of the problem-level tests: 3 keyframes at 160x120.
+WindowedBASimulation SmallWindow() {
+  WindowedBASimulationOptions simulation_options;
+  simulation_options.num_keyframes = 3;
+  simulation_options.width = 160;
+  simulation_options.height = 120;
+  simulation_options.focal = 131.0;
+  return SimulateWindowedBAWindow(simulation_options);
+}
+
 // The default window (4 keyframes 10 cm apart, 320x240, poses off by 2.5 mm / 0.1 deg per axis,
 // inverse depths by 2.5%, brightness off by up to 0.05 in a and 9 gray levels in b), solved with
 // the defaults (builder windowed_ba, ceres SPARSE_SCHUR, 800 points): measured rotation RMS
@@ -220,12 +230,7 @@ TEST(WindowedBATest, CeresAndGaussNewtonAgreeOnTheSameWindow) {
 // keyframe), one eliminated 1-D block per point, the photometric weights from eq. 5 at the
 // linearisation point (recomputed here for every row of a block), not constants.
 TEST(WindowedBATest, ProblemHasTheGaugeAndCovarianceWeights) {
-  WindowedBASimulationOptions simulation_options;
-  simulation_options.num_keyframes = 3;
-  simulation_options.width = 160;
-  simulation_options.height = 120;
-  simulation_options.focal = 131.0;
-  const WindowedBASimulation simulation = SimulateWindowedBAWindow(simulation_options);
+  const WindowedBASimulation simulation = SmallWindow();
   WindowedBAOptions options;
   options.window = 3;
   options.max_points = 150;
@@ -307,23 +312,12 @@ TEST(WindowedBATest, ProblemHasTheGaugeAndCovarianceWeights) {
   }
 }
 
-// After a solve the gauge holds: the oldest pose and brightness are the inputs, the baseline to
-// the second keyframe is the input's. Without inverse-depth priors the data are exactly
-// scale-invariant, so the baseline prior's residual is 0 at the optimum. Without them some
-// inverse depths are barely constrained and the solve crawls (docs/windowed_ba.md), stopping
-// 5.4e-4 relative from the input baseline (measured; bound 2e-3, against the prior's sigma of
-// 1e-2 and the inputs' scale error of a few percent).
 // newest_keyframe_points: target_only leaves the newest keyframe (whose map the odometry
 // propagates from the previous one) without points, a target only, and the other keyframes share
 // max_points; host_no_prior keeps its points and drops only their inverse-depth priors. Measured
 // on this 3-keyframe window: hosts 0/1/2 get 45/48/48 points with host, 70/75/0 with target_only.
 TEST(WindowedBATest, NewestKeyframePointsChoosesWhatTheNewestHosts) {
-  WindowedBASimulationOptions simulation_options;
-  simulation_options.num_keyframes = 3;
-  simulation_options.width = 160;
-  simulation_options.height = 120;
-  simulation_options.focal = 131.0;
-  const WindowedBASimulation simulation = SimulateWindowedBAWindow(simulation_options);
+  const WindowedBASimulation simulation = SmallWindow();
   WindowedBAOptions options;
   options.window = 3;
   options.max_points = 150;
@@ -353,13 +347,14 @@ TEST(WindowedBATest, NewestKeyframePointsChoosesWhatTheNewestHosts) {
   EXPECT_GT(target_only.hosted[1], host.hosted[1]);
 }
 
+// After a solve the gauge holds: the oldest pose and brightness are the inputs, the baseline to
+// the second keyframe is the input's. Without inverse-depth priors the data are exactly
+// scale-invariant, so the baseline prior's residual is 0 at the optimum. Without them some
+// inverse depths are barely constrained and the solve crawls (docs/windowed_ba.md), stopping
+// 5.4e-4 relative from the input baseline (measured; bound 2e-3, against the prior's sigma of
+// 1e-2 and the inputs' scale error of a few percent).
 TEST(WindowedBATest, SolveKeepsTheGauge) {
-  WindowedBASimulationOptions simulation_options;
-  simulation_options.num_keyframes = 3;
-  simulation_options.width = 160;
-  simulation_options.height = 120;
-  simulation_options.focal = 131.0;
-  const WindowedBASimulation simulation = SimulateWindowedBAWindow(simulation_options);
+  const WindowedBASimulation simulation = SmallWindow();
   WindowedBAOptions options;
   options.window = 3;
   options.max_points = 150;
