@@ -200,6 +200,14 @@ std::string ChoiceName(const ChoiceRef& choice) {
   return index >= 0 ? choice.names[index] : "<unnamed value>";
 }
 
+// WriteConfigYaml must round-trip, and YAML folds or rejects a raw control character in a
+// scalar, so string values from a file (escapes such as "\n") or an override may hold none.
+const char kControlCharacterError[] = "control characters are not allowed";
+bool HasControlCharacter(const std::string& text) {
+  return std::any_of(text.begin(), text.end(),
+                     [](char c) { return static_cast<unsigned char>(c) < 0x20; });
+}
+
 // The value as YAML text.
 std::string YamlValue(const ConfigEntry& entry) {
   struct Visitor {
@@ -227,10 +235,7 @@ std::string SetFromText(const ConfigEntry& entry, const std::string& text) {
       return ParseDouble(text, value) ? "" : "expected a number, got '" + text + "'";
     }
     std::string operator()(std::string* value) const {
-      // WriteConfigYaml must round-trip, and YAML allows no raw control character in a scalar.
-      for (char c : text) {
-        if (static_cast<unsigned char>(c) < 0x20) return "control characters are not allowed";
-      }
+      if (HasControlCharacter(text)) return kControlCharacterError;
       *value = text;
       return "";
     }
@@ -283,9 +288,13 @@ std::string SetFromNode(const ConfigEntry& entry, const YamlNode& node) {
       return node.GetDouble(value) ? "" : "expected a number, got " + node.Describe();
     }
     std::string operator()(std::string* value) const {
-      return node.GetString(value)
-                 ? ""
-                 : "expected a string (quote it: \"...\"), got " + node.Describe();
+      std::string text;
+      if (!node.GetString(&text)) {
+        return "expected a string (quote it: \"...\"), got " + node.Describe();
+      }
+      if (HasControlCharacter(text)) return kControlCharacterError;
+      *value = text;
+      return "";
     }
     std::string operator()(std::vector<double>* value) const {
       if (!node.IsList()) return "expected a list of numbers like [1, 2], got " + node.Describe();

@@ -23,6 +23,7 @@ namespace pldvo {
 namespace {
 
 namespace fs = std::filesystem;
+using ::testing::AllOf;
 using ::testing::HasSubstr;
 
 // The message of the std::exception `f` throws, or "" if it does not throw.
@@ -159,6 +160,18 @@ TEST_F(ParserRegressionTest, OverrideWithControlCharacterIsRejected) {
   StringOptions copy;
   LoadConfigYaml(path, &copy);
   EXPECT_EQ(copy.name, options.name);
+}
+
+// A file's string with an escaped line break ("\n") was read, then written by ConfigToString as
+// a raw line break that YAML folds into a space (config_fuzzer: the round trip broke).
+TEST_F(ParserRegressionTest, FileStringWithControlCharacterIsRejected) {
+  StringOptions options;
+  const std::string path = Write("config.yaml", "name: \"tum_\\nfr3\"\n");
+  EXPECT_THAT(ErrorOf([&] { LoadConfigYaml(path, &options); }),
+              AllOf(HasSubstr(path), HasSubstr("control characters")));
+  EXPECT_EQ(options.name, "a");
+  LoadConfigYaml(Write("config.yaml", "name: \"tum \\\"fr3\\\" \\\\ \"\n"), &options);
+  EXPECT_EQ(options.name, "tum \"fr3\" \\ ");
 }
 
 // A line of only '\v' or '\f' gave a table line without fields; the KITTI calib.txt reader
