@@ -14,24 +14,13 @@
 
 #include "backend/edge_ba/edge_ba_line_depth.h"
 #include "backend/edge_ba/edge_ba_solver.h"
+#include "backend/odometry/alternative_choice.h"
 #include "backend/odometry/keyframe_selector.h"
 #include "backend/odometry/reference_builder.h"
 #include "core/wall_clock.h"
 
 namespace pldvo {
 namespace {
-
-// a is a better tracking result than b: not lost beats lost, then more inlier rows at the
-// finest level. (Not the lower RMS: a wrong pose that pushes points out of the image or onto
-// flat regions can have fewer valid rows and a lower RMS; measured in docs/odometry.md.)
-bool Better(const TrackingResult& a, const TrackingResult& b) {
-  const bool a_lost = a.status == TrackingStatus::kLost;
-  const bool b_lost = b.status == TrackingStatus::kLost;
-  if (a_lost != b_lost) return !a_lost;
-  const int a_inliers = a.levels.empty() ? 0 : a.levels.back().inlier_rows;
-  const int b_inliers = b.levels.empty() ? 0 : b.levels.back().inlier_rows;
-  return a_inliers > b_inliers;
-}
 
 // Maps keyframe segments into the frame with the homography of cur_from_kf and the
 // fronto-parallel plane at inverse depth `idepth` (z = 1 / idepth in the keyframe):
@@ -502,7 +491,7 @@ TrackingResult Odometry::TrackWithAlternatives(const ImagePyramid& pyramid, cons
   for (const SE3& guess : guesses) {
     TrackingResult result = tracker_.Track(reference_, pyramid, guess, brightness_, callback);
     ++*tried;
-    if (Better(result, best)) best = std::move(result);
+    if (BetterAlternative(result, best, options.alternative_choice)) best = std::move(result);
   }
   return best;
 }

@@ -120,10 +120,15 @@ struct OdometryOptions {
   // is lost, or when its final photometric RMS exceeds retry_rms_ratio times the running mean
   // over recent tracked frames (backend/odometry/retry_trigger.h): zero motion since the last good
   // frame, and that pose rotated by +-alternative_rotation_deg about the camera's x and y axes.
-  // The best non-lost result (most inlier rows at the finest level) wins.
+  // The best non-lost result wins by alternative_choice (backend/odometry/alternative_choice.h):
+  // the most inlier rows at the finest level, the most inlier rows times the intensity
+  // correlation of its photometric rows, or more inlier rows and a correlation no lower (a wrong
+  // pose can gain inlier rows where the images no longer correlate).
   bool try_alternatives = true;
   double retry_rms_ratio = 1.5;
   double alternative_rotation_deg = 2.0;
+  enum class AlternativeChoice { kInlierRows, kCorrelatedInlierRows, kRowsAndCorrelation };
+  AlternativeChoice alternative_choice = AlternativeChoice::kInlierRows;
   // Lost tracking: a lost frame gets the constant-velocity extrapolation of the last good pose
   // (marked lost, not mapped). After this many consecutive lost frames the odometry
   // re-initialises: the current frame becomes a keyframe at the extrapolated pose, with the old
@@ -232,6 +237,14 @@ struct OdometryOptions {
             "Retry when the final photometric RMS exceeds this times the recent mean (1.5).");
     v.Field("alternative_rotation_deg", &alternative_rotation_deg,
             "Rotation of the alternative guesses about the camera x and y axes, deg (default 2).");
+    v.Choice("alternative_choice", &alternative_choice,
+             ChoiceNames<AlternativeChoice>{
+                 {"inlier_rows", AlternativeChoice::kInlierRows},
+                 {"correlated_inlier_rows", AlternativeChoice::kCorrelatedInlierRows},
+                 {"rows_and_correlation", AlternativeChoice::kRowsAndCorrelation}},
+             "Which retried result wins: inlier_rows (most inlier rows) | correlated_inlier_rows "
+             "(inlier rows x intensity correlation) | rows_and_correlation (more inlier rows and "
+             "a correlation no lower) (default inlier_rows).");
     v.Field("reinit_after_lost", &reinit_after_lost,
             "Consecutive lost frames before re-initialising at the current frame (default 3).");
     v.Field("reinit_min_points", &reinit_min_points,

@@ -1,0 +1,33 @@
+#include "backend/odometry/alternative_choice.h"
+
+#include <algorithm>
+
+namespace pldvo {
+
+double AlternativeScore(const TrackingResult& result, OdometryOptions::AlternativeChoice choice) {
+  if (result.levels.empty()) return 0.0;
+  const LevelResult& finest = result.levels.back();
+  // The correlation is defined over at least 2 photometric rows (LevelResult).
+  const bool correlated = choice == OdometryOptions::AlternativeChoice::kCorrelatedInlierRows &&
+                          finest.photometric_valid_rows >= 2;
+  return correlated ? finest.inlier_rows * std::max(finest.intensity_correlation, 0.0)
+                    : finest.inlier_rows;
+}
+
+bool BetterAlternative(const TrackingResult& a, const TrackingResult& b,
+                       OdometryOptions::AlternativeChoice choice) {
+  const bool a_lost = a.status == TrackingStatus::kLost;
+  const bool b_lost = b.status == TrackingStatus::kLost;
+  if (a_lost != b_lost) return !a_lost;
+  if (choice == OdometryOptions::AlternativeChoice::kRowsAndCorrelation) {
+    if (a.levels.empty() || b.levels.empty()) return !a.levels.empty();
+    const LevelResult& fa = a.levels.back();
+    const LevelResult& fb = b.levels.back();
+    const bool correlated = fa.photometric_valid_rows >= 2 && fb.photometric_valid_rows >= 2;
+    return fa.inlier_rows > fb.inlier_rows &&
+           (!correlated || fa.intensity_correlation >= fb.intensity_correlation);
+  }
+  return AlternativeScore(a, choice) > AlternativeScore(b, choice);
+}
+
+}  // namespace pldvo
