@@ -3,13 +3,18 @@
 #include <algorithm>
 
 namespace pldvo {
+namespace {
+
+// The correlation is defined over at least 2 photometric rows (LevelResult).
+bool HasCorrelation(const LevelResult& level) { return level.photometric_valid_rows >= 2; }
+
+}  // namespace
 
 double AlternativeScore(const TrackingResult& result, OdometryOptions::AlternativeChoice choice) {
   if (result.levels.empty()) return 0.0;
   const LevelResult& finest = result.levels.back();
-  // The correlation is defined over at least 2 photometric rows (LevelResult).
-  const bool correlated = choice == OdometryOptions::AlternativeChoice::kCorrelatedInlierRows &&
-                          finest.photometric_valid_rows >= 2;
+  const bool correlated =
+      choice == OdometryOptions::AlternativeChoice::kCorrelatedInlierRows && HasCorrelation(finest);
   return correlated ? finest.inlier_rows * std::max(finest.intensity_correlation, 0.0)
                     : finest.inlier_rows;
 }
@@ -23,7 +28,7 @@ bool BetterAlternative(const TrackingResult& a, const TrackingResult& b,
     if (a.levels.empty() || b.levels.empty()) return !a.levels.empty();
     const LevelResult& fa = a.levels.back();
     const LevelResult& fb = b.levels.back();
-    const bool correlated = fa.photometric_valid_rows >= 2 && fb.photometric_valid_rows >= 2;
+    const bool correlated = HasCorrelation(fa) && HasCorrelation(fb);
     return fa.inlier_rows > fb.inlier_rows &&
            (!correlated || fa.intensity_correlation >= fb.intensity_correlation);
   }

@@ -238,10 +238,9 @@ struct OdometryOptions {
     v.Field("alternative_rotation_deg", &alternative_rotation_deg,
             "Rotation of the alternative guesses about the camera x and y axes, deg (default 2).");
     v.Choice("alternative_choice", &alternative_choice,
-             ChoiceNames<AlternativeChoice>{
-                 {"inlier_rows", AlternativeChoice::kInlierRows},
-                 {"correlated_inlier_rows", AlternativeChoice::kCorrelatedInlierRows},
-                 {"rows_and_correlation", AlternativeChoice::kRowsAndCorrelation}},
+             {{"inlier_rows", AlternativeChoice::kInlierRows},
+              {"correlated_inlier_rows", AlternativeChoice::kCorrelatedInlierRows},
+              {"rows_and_correlation", AlternativeChoice::kRowsAndCorrelation}},
              "Which retried result wins: inlier_rows (most inlier rows) | correlated_inlier_rows "
              "(inlier rows x intensity correlation) | rows_and_correlation (more inlier rows and "
              "a correlation no lower) (default inlier_rows).");
