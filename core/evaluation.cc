@@ -7,6 +7,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "core/constant_velocity_start.h"
+
 namespace pldvo {
 namespace {
 
@@ -111,6 +113,7 @@ std::string EvaluationOptions::Check() const {
   if (!(max_time_diff >= 0.0)) return "max_time_diff must be >= 0";
   if (!(rpe_delta > 0.0)) return "rpe_delta must be > 0";
   if (!(scale_window > 0.0)) return "scale_window must be > 0";
+  if (!(constant_velocity_tolerance >= 0.0)) return "constant_velocity_tolerance must be >= 0";
   return "";
 }
 
@@ -133,6 +136,26 @@ EvaluationResult EvaluateTrajectory(const Trajectory& ground_truth, const Trajec
   if (!problem.empty()) throw std::invalid_argument("evaluation options: " + problem);
   RequireIncreasing(ground_truth, "ground truth");
   RequireIncreasing(estimate, "estimate");
+  const int constant_start =
+      ConstantVelocityStartPoses(ground_truth, options.constant_velocity_tolerance);
+  // A path that is one constant velocity throughout (a synthetic test) is evaluated whole.
+  if (options.skip_constant_velocity_start && constant_start > 0 &&
+      constant_start < static_cast<int>(ground_truth.size())) {
+    // From the start's last pose on; the estimate's poses before it cannot be associated.
+    const Trajectory measured(ground_truth.begin() + (constant_start - 1), ground_truth.end());
+    Trajectory later;
+    for (const StampedPose& pose : estimate) {
+      if (pose.timestamp >= measured.front().timestamp - options.max_time_diff) {
+        later.push_back(pose);
+      }
+    }
+    EvaluationOptions all = options;
+    all.skip_constant_velocity_start = false;
+    EvaluationResult result = EvaluateTrajectory(measured, later, all);
+    result.constant_velocity_start_poses = constant_start;
+    result.skipped_ground_truth_poses = constant_start - 1;
+    return result;
+  }
   const std::vector<std::pair<int, int>> matches =
       AssociateByTimestamp(estimate, ground_truth, options.max_time_diff);
   if (matches.size() < 3) {
@@ -143,6 +166,7 @@ EvaluationResult EvaluateTrajectory(const Trajectory& ground_truth, const Trajec
   }
   EvaluationResult result;
   result.num_associated = static_cast<int>(matches.size());
+  result.constant_velocity_start_poses = constant_start;
 
   // ATE after Sim(3) alignment of the estimate's positions onto the ground truth's.
   std::vector<Eigen::Vector3d> est_positions, gt_positions;

@@ -43,6 +43,13 @@ struct EvaluationOptions {
   bool align_scale = true;
   // Length of the windows of the scale drift (window_scales), seconds.
   double scale_window = 1.0;
+  // Ground truth that starts at one constant velocity (core/constant_velocity_start.h): the
+  // relative change of consecutive velocities up to which they count as one, and whether to
+  // evaluate from the last pose of such a start only (false: every pose, as the TUM and KITTI
+  // tools do; the start is reported either way; a path at one velocity throughout is evaluated
+  // whole).
+  double constant_velocity_tolerance = 1e-4;
+  bool skip_constant_velocity_start = false;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
@@ -53,6 +60,12 @@ struct EvaluationOptions {
             "Align with Sim(3) (true, monocular) or SE(3) (false) before ATE and RPE.");
     v.Field("scale_window", &scale_window,
             "Window (s) of the local scale: estimated over ground-truth path length.");
+    v.Field("constant_velocity_tolerance", &constant_velocity_tolerance,
+            "Consecutive ground-truth velocities differing by at most this fraction of the speed "
+            "are one constant velocity (an extrapolated start; default 1e-4).");
+    v.Field("skip_constant_velocity_start", &skip_constant_velocity_start,
+            "Evaluate from the last pose of a ground-truth start of >= 5 constant-velocity steps "
+            "(e.g. KITTI 00's first 14 poses; default false: every pose).");
   }
   // "" when valid, otherwise what is wrong.
   std::string Check() const;
@@ -81,6 +94,10 @@ struct EvaluationResult {
   int num_pairs = 0;       // RPE pairs
   int num_associated = 0;  // estimate poses associated with ground truth
   Sim3Alignment gt_from_est;
+  // Leading ground-truth poses at one constant velocity (0: none of >= 5 steps) and how many of
+  // them were left out (skip_constant_velocity_start: all but the last).
+  int constant_velocity_start_poses = 0;
+  int skipped_ground_truth_poses = 0;
 };
 
 // (estimate index, ground-truth index) pairs: each estimate pose with the nearest ground-truth

@@ -86,10 +86,11 @@ std::string BackendOptions::Check() const {
 
 std::string OdometryConfig::Check() const {
   const std::pair<const char*, std::string> sections[] = {
-      {"dataset", dataset.Check()},     {"lines", lines.Check()},
-      {"tracking", tracking.Check()},   {"mapping", mapping.Check()},
-      {"keyframes", keyframes.Check()}, {"odometry", odometry.Check()},
-      {"output", output.Check()},       {"backend", backend.Check()}};
+      {"dataset", dataset.Check()},      {"lines", lines.Check()},
+      {"tracking", tracking.Check()},    {"mapping", mapping.Check()},
+      {"keyframes", keyframes.Check()},  {"odometry", odometry.Check()},
+      {"output", output.Check()},        {"backend", backend.Check()},
+      {"evaluation", evaluation.Check()}};
   for (const auto& [name, error] : sections) {
     if (!error.empty()) return std::string(name) + ": " + error;
   }

@@ -25,6 +25,7 @@
 #include "backend/tracking/tracker.h"
 #include "backend/windowed_ba/windowed_ba_options.h"
 #include "core/dataset.h"
+#include "core/evaluation.h"
 #include "core/options.h"
 #include "frontend/line_frontend_options.h"
 
@@ -391,6 +392,7 @@ struct OdometryConfig {
   OdometryOptions odometry;
   OutputOptions output;
   BackendOptions backend;
+  EvaluationOptions evaluation;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
@@ -403,6 +405,8 @@ struct OdometryConfig {
     v.Section("output", &output, "Optional outputs of `pldvo run`.");
     v.Section("backend", &backend,
               "Optimisation beside tracking (edge or photometric windowed bundle adjustment).");
+    v.Section("evaluation", &evaluation,
+              "Accuracy against the dataset's ground truth in summary.json (docs/evaluation.md).");
   }
   // "" when valid, otherwise the first section and what is wrong there.
   std::string Check() const;

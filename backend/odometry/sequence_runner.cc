@@ -325,10 +325,11 @@ void AddTimingSummary(const std::vector<TimingRow>& rows, const std::vector<doub
 
 // The accuracy against the dataset's ground truth into the summary; the report's line.
 std::string AddEvaluation(const Trajectory& ground_truth, const Trajectory& estimate,
-                          nlohmann::json* summary, Sim3Alignment* gt_from_est) {
+                          const EvaluationOptions& options, nlohmann::json* summary,
+                          Sim3Alignment* gt_from_est) {
   nlohmann::json& s = *summary;
   try {
-    const EvaluationResult eval = EvaluateTrajectory(ground_truth, estimate);
+    const EvaluationResult eval = EvaluateTrajectory(ground_truth, estimate, options);
     *gt_from_est = eval.gt_from_est;
     s["rpe_cm_s"] = NumberOrNull(eval.rpe_cm_s);
     s["rpe_deg_s"] = NumberOrNull(eval.rpe_deg_s);
@@ -337,10 +338,20 @@ std::string AddEvaluation(const Trajectory& ground_truth, const Trajectory& esti
     s["scale"] = eval.scale;
     s["scale_drift"] = NumberOrNull(eval.scale_drift);
     s["window_scales"] = eval.window_scales;
+    s["ground_truth_constant_velocity_start"] = eval.constant_velocity_start_poses;
+    s["skipped_ground_truth_poses"] = eval.skipped_ground_truth_poses;
     std::ostringstream line;
     line << std::fixed << std::setprecision(3) << "RPE " << eval.rpe_cm_s << " cm/s, "
          << eval.rpe_deg_s << " deg/s; ATE " << std::setprecision(4) << eval.ate_m
          << " m; coverage " << std::setprecision(3) << eval.coverage;
+    if (eval.skipped_ground_truth_poses > 0) {
+      line << "; from ground-truth pose " << eval.skipped_ground_truth_poses
+           << " on (the poses before move at one constant velocity)";
+    } else if (eval.constant_velocity_start_poses > 0) {
+      line << "; the ground truth's first " << eval.constant_velocity_start_poses
+           << " poses move at one constant velocity (extrapolated?"
+           << " evaluation.skip_constant_velocity_start)";
+    }
     return line.str();
   } catch (const std::exception& e) {
     s["rpe_cm_s"] = nullptr;
@@ -354,9 +365,9 @@ std::string AddEvaluation(const Trajectory& ground_truth, const Trajectory& esti
 
 // motion_errors.csv and summary.json's medians of its columns (docs/evaluation.md).
 void AddFrameMotionErrors(const Trajectory& ground_truth, const Trajectory& estimate, double scale,
-                          const std::string& out, nlohmann::json* summary) {
+                          double max_time_diff, const std::string& out, nlohmann::json* summary) {
   const std::vector<FrameMotionError> errors =
-      EvaluateFrameMotion(ground_truth, estimate, scale, EvaluationOptions().max_time_diff);
+      EvaluateFrameMotion(ground_truth, estimate, scale, max_time_diff);
   std::ofstream file(out + "/motion_errors.csv");
   WriteFrameMotionErrorsCsv(errors, file);
   if (!file) throw RunOutputError("cannot write " + out + "/motion_errors.csv");
@@ -580,13 +591,16 @@ SequenceRunResult SequenceRunner::Run() {
         }
       }
       try {
-        ba["keyframes_ate_m_tracked"] = EvaluateTrajectory(*ground_truth, keyframes_tracked).ate_m;
-        ba["keyframes_ate_m_ba"] = EvaluateTrajectory(*ground_truth, keyframes_ba).ate_m;
+        ba["keyframes_ate_m_tracked"] =
+            EvaluateTrajectory(*ground_truth, keyframes_tracked, config_.evaluation).ate_m;
+        ba["keyframes_ate_m_ba"] =
+            EvaluateTrajectory(*ground_truth, keyframes_ba, config_.evaluation).ate_m;
       } catch (const std::exception& e) {
         ba["keyframes_evaluation_error"] = e.what();
       }
       try {
-        const EvaluationResult eval = EvaluateTrajectory(*ground_truth, reanchored);
+        const EvaluationResult eval =
+            EvaluateTrajectory(*ground_truth, reanchored, config_.evaluation);
         ba["reanchored_rpe_cm_s"] = NumberOrNull(eval.rpe_cm_s);
         ba["reanchored_rpe_deg_s"] = NumberOrNull(eval.rpe_deg_s);
         ba["reanchored_ate_m"] = eval.ate_m;
@@ -616,13 +630,17 @@ SequenceRunResult SequenceRunner::Run() {
   Sim3Alignment gt_from_est;
   bool aligned = false;
   if (ground_truth != nullptr && !ground_truth->empty()) {
-    const std::string line = AddEvaluation(*ground_truth, estimate, &summary, &gt_from_est);
+    const std::string line =
+        AddEvaluation(*ground_truth, estimate, config_.evaluation, &summary, &gt_from_est);
     aligned = !summary.contains("evaluation_error");
     result.report.push_back("  " + line);
-    if (aligned) AddFrameMotionErrors(*ground_truth, estimate, gt_from_est.scale, out, &summary);
+    if (aligned) {
+      AddFrameMotionErrors(*ground_truth, estimate, gt_from_est.scale,
+                           config_.evaluation.max_time_diff, out, &summary);
+    }
   }
   if (comparison != nullptr) {
-    summary["compare_solver"] = comparison->Summary(ground_truth);
+    summary["compare_solver"] = comparison->Summary(ground_truth, config_.evaluation);
     result.report.push_back("  " + comparison->Line(summary["compare_solver"]));
   }
   if (observer_ != nullptr) {

@@ -49,7 +49,8 @@ bool SolverComparison::Add(const OdometryFrameResult& result) {
   return static_cast<bool>(file_.flush());
 }
 
-nlohmann::json SolverComparison::Summary(const Trajectory* ground_truth) const {
+nlohmann::json SolverComparison::Summary(const Trajectory* ground_truth,
+                                         const EvaluationOptions& evaluation) const {
   nlohmann::json summary;
   summary["solver"] = solver_name_;
   std::vector<double> translation_m, rotation_deg;
@@ -84,7 +85,7 @@ nlohmann::json SolverComparison::Summary(const Trajectory* ground_truth) const {
   summary["run_tracking_ms_median"] = Median(run_tracking_ms_);
   if (ground_truth != nullptr && !ground_truth->empty()) {
     try {
-      const EvaluationResult eval = EvaluateTrajectory(*ground_truth, trajectory_);
+      const EvaluationResult eval = EvaluateTrajectory(*ground_truth, trajectory_, evaluation);
       summary["rpe_cm_s"] = std::isfinite(eval.rpe_cm_s) ? nlohmann::json(eval.rpe_cm_s) : nullptr;
       summary["rpe_deg_s"] =
           std::isfinite(eval.rpe_deg_s) ? nlohmann::json(eval.rpe_deg_s) : nullptr;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "backend/odometry/odometry_observer.h"
+#include "core/evaluation.h"
 #include "core/trajectory_io.h"
 
 namespace pldvo {
@@ -30,11 +31,13 @@ class SolverComparison {
   // The summary.json object: solver, frames compared, frames the other solver lost, median and
   // max translation (m) and rotation (deg) differences, median ms of one tracking solve (the
   // final one; the run's tracking_ms also holds alternative guesses and re-tracking), and
-  // with ground truth rpe_cm_s / rpe_deg_s / ate_m of the compared trajectory.
+  // with ground truth rpe_cm_s / rpe_deg_s / ate_m of the compared trajectory (evaluated with
+  // `evaluation`, the run's options).
   // `largest_differences`: the kLargestDifferences frames with the largest translation
   // difference, largest first, each with both solvers' final cost and valid rows at the finest
   // level (whether one solver stopped short or the two found different minima).
-  nlohmann::json Summary(const Trajectory* ground_truth) const;
+  nlohmann::json Summary(const Trajectory* ground_truth,
+                         const EvaluationOptions& evaluation = {}) const;
   static constexpr int kLargestDifferences = 5;
   // One line for the run's final table.
   std::string Line(const nlohmann::json& summary) const;

@@ -1,7 +1,7 @@
 // `pldvo eval --gt FILE --est FILE [--json] [--motion_errors CSV]`: ATE, RPE, coverage and scale
 // drift of an estimated trajectory against ground truth, both in TUM format (docs/evaluation.md).
 // `--set key=value` sets the EvaluationOptions (max_time_diff, rpe_delta, align_scale,
-// scale_window).
+// scale_window, constant_velocity_tolerance, skip_constant_velocity_start).
 #include <gflags/gflags.h>
 
 #include <cmath>
@@ -62,6 +62,8 @@ int RunEval(const CommandContext& context) {
       json["num_associated"] = result.num_associated;
       json["num_estimate"] = estimate.size();
       json["num_ground_truth"] = ground_truth.size();
+      json["ground_truth_constant_velocity_start"] = result.constant_velocity_start_poses;
+      json["skipped_ground_truth_poses"] = result.skipped_ground_truth_poses;
       std::cout << json.dump() << "\n";
       return 0;
     }
@@ -78,6 +80,13 @@ int RunEval(const CommandContext& context) {
               << "  (estimate units per gt metre, per " << options.scale_window << " s:";
     for (double scale : result.window_scales) std::cout << " " << std::setprecision(3) << scale;
     std::cout << ")\n";
+    if (result.constant_velocity_start_poses > 0) {
+      std::cout << "ground truth:              its first " << result.constant_velocity_start_poses
+                << " poses move at one constant velocity (extrapolated?); "
+                << (result.skipped_ground_truth_poses > 0
+                        ? "evaluated from the last of them on\n"
+                        : "included (--set skip_constant_velocity_start=true leaves them out)\n");
+    }
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "pldvo eval: " << e.what() << "\n";

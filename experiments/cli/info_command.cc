@@ -10,7 +10,9 @@
 #include <opencv2/core.hpp>
 
 #include "core/config_io.h"
+#include "core/constant_velocity_start.h"
 #include "core/dataset.h"
+#include "core/evaluation.h"
 #include "experiments/cli/command.h"
 #include "experiments/cli/common_flags.h"
 
@@ -48,6 +50,13 @@ int RunInfo(const CommandContext& context) {
       std::cout << "ground truth: yes, " << ground_truth->size() << " poses, "
                 << ground_truth->front().timestamp << " .. " << ground_truth->back().timestamp
                 << " s\n";
+      const int constant = ConstantVelocityStartPoses(
+          *ground_truth, EvaluationOptions().constant_velocity_tolerance);
+      if (constant > 0) {
+        std::cout << "              its first " << constant
+                  << " poses move at one constant velocity: extrapolated, not measured?"
+                  << " (docs/evaluation.md, \"Extrapolated ground truth\")\n";
+      }
     } else {
       std::cout << "ground truth: no\n";
     }

@@ -181,6 +181,44 @@ TEST(EvaluateTrajectory, RpeOfConstantVelocityWithKnownHeadingDrift) {
   EXPECT_NEAR(result.rpe_deg_s, 0.0, 1e-7);
   // Pairs (i, i + 10) for i = 0..90.
   EXPECT_EQ(result.num_pairs, 91);
+  // The ground truth is one constant velocity throughout: reported, and evaluated whole even
+  // when its start is to be skipped.
+  EXPECT_EQ(result.constant_velocity_start_poses, 101);
+  EvaluationOptions skip;
+  skip.skip_constant_velocity_start = true;
+  const EvaluationResult skipped = EvaluateTrajectory(gt, est, skip);
+  EXPECT_EQ(skipped.skipped_ground_truth_poses, 0);
+  EXPECT_NEAR(skipped.rpe_cm_s, 10.0, 1e-7);
+}
+
+TEST(EvaluateTrajectory, SkippingAConstantVelocityStartEvaluatesFromItsLastPose) {
+  // gt: 15 poses at one velocity (1 m/s along z, 10 Hz), then a curve. est: exact from pose 14
+  // on, but 20% slower over the start (as an estimate that finds the acceleration the
+  // extrapolated ground truth lacks). Whole: the start's error shows; skipped: RPE and ATE 0
+  // over the 26 poses from pose 14, which is kept as the first.
+  Trajectory gt, est;
+  for (int i = 0; i < 40; ++i) {
+    const double t = 0.1 * i;
+    const double s = t - 1.4;  // time since pose 14
+    const Eigen::Vector3d p =
+        i <= 14 ? Eigen::Vector3d(0, 0, t) : Eigen::Vector3d(0.3 * s * s, 0.1 * s * s * s, 1.4 + s);
+    gt.push_back(Pose(t, p));
+    est.push_back(Pose(t, i <= 14 ? Eigen::Vector3d(0, 0, 1.4 + 0.8 * s) : p));
+  }
+  const EvaluationResult whole = EvaluateTrajectory(gt, est);
+  EXPECT_EQ(whole.constant_velocity_start_poses, 15);
+  EXPECT_EQ(whole.skipped_ground_truth_poses, 0);
+  EXPECT_EQ(whole.num_associated, 40);
+  EXPECT_GT(whole.rpe_cm_s, 5.0);
+  EvaluationOptions skip;
+  skip.skip_constant_velocity_start = true;
+  const EvaluationResult skipped = EvaluateTrajectory(gt, est, skip);
+  EXPECT_EQ(skipped.constant_velocity_start_poses, 15);
+  EXPECT_EQ(skipped.skipped_ground_truth_poses, 14);
+  EXPECT_EQ(skipped.num_associated, 26);
+  EXPECT_NEAR(skipped.rpe_cm_s, 0.0, 1e-7);
+  EXPECT_NEAR(skipped.ate_m, 0.0, kTolerance);
+  EXPECT_NEAR(skipped.coverage, 1.0, kTolerance);
 }
 
 TEST(EvaluateTrajectory, RpeOfConstantRotationalDrift) {
