@@ -17,6 +17,7 @@ dev_set_families=(
   "brightp20|--preset lowtex --set brightness=0.2"
   "brightm20|--preset lowtex --set brightness=-0.2"
   "autoexposure|--preset autoexposure"
+  "vignetting|--preset lowtex --vignetting"
   "checkerboard|--preset checkerboard"
   "boxes|--preset boxes"
   "handheld|--preset handheld"
