@@ -157,18 +157,17 @@ awk -F, -v wanted="$wanted" -v repeats="$repeats" -v frames="$frames" '
 # the same runs from the last of them on, median over the initial maps.
 for d in "${datasets[@]}"; do
   name=$(basename "$d")
-  [ -n "$(ls -d "$ablation/runs/${name}__"* 2>/dev/null)" ] || continue
-  "$pldvo" info --dataset "$d" 2>/dev/null | grep -q "constant velocity" || continue
-  echo
-  echo "$name from the last pose of its ground truth's constant-velocity start:"
   for config in sdvo points_lines; do
     for run in "$ablation/runs/${name}__${config}__"*/; do
       [ -f "$run/trajectory.txt" ] || continue
-      "$pldvo" eval --gt "$run/groundtruth.txt" --est "$run/trajectory.txt" \
-        --set skip_constant_velocity_start=true | awk '/^RPE translation/ { print $3 }'
-    done | sort -g | awk -v c="$config" '{ v[NR] = $1 } END { if (NR == 0) exit
+      json=$("$pldvo" eval --gt "$run/groundtruth.txt" --est "$run/trajectory.txt" --json \
+        --set skip_constant_velocity_start=true 2>/dev/null) || continue
+      echo "$json" | grep -q '"skipped_ground_truth_poses":[1-9]' || continue
+      echo "$json" | grep -o '"rpe_cm_s":[0-9.e+-]*' | cut -d: -f2
+    done | sort -g | awk -v c="$config" -v d="$name" '{ v[NR] = $1 } END { if (NR == 0) exit
       m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2
-      printf "  %-13s RPE %.2f [%.2f, %.2f] cm/s\n", c, m, v[1], v[NR] }'
+      printf "%s %-13s from the last pose of its ground truth'"'"'s constant-velocity start: " \
+        "RPE %.2f [%.2f, %.2f] cm/s\n", d, c, m, v[1], v[NR] }'
   done
 done
 echo

@@ -23,6 +23,12 @@ StampedPose Pose(double t, const Eigen::Vector3d& position,
   return pose;
 }
 
+EvaluationOptions SkippingConstantVelocityStart() {
+  EvaluationOptions options;
+  options.skip_constant_velocity_start = true;
+  return options;
+}
+
 // A smooth non-planar path (so the alignment is unique) with a turning camera, 10 Hz.
 Trajectory CurvedTrajectory(int n) {
   Trajectory trajectory;
@@ -184,9 +190,7 @@ TEST(EvaluateTrajectory, RpeOfConstantVelocityWithKnownHeadingDrift) {
   // The ground truth is one constant velocity throughout: reported, and evaluated whole even
   // when its start is to be skipped.
   EXPECT_EQ(result.constant_velocity_start_poses, 101);
-  EvaluationOptions skip;
-  skip.skip_constant_velocity_start = true;
-  const EvaluationResult skipped = EvaluateTrajectory(gt, est, skip);
+  const EvaluationResult skipped = EvaluateTrajectory(gt, est, SkippingConstantVelocityStart());
   EXPECT_EQ(skipped.skipped_ground_truth_poses, 0);
   EXPECT_NEAR(skipped.rpe_cm_s, 10.0, 1e-7);
 }
@@ -210,9 +214,7 @@ TEST(EvaluateTrajectory, SkippingAConstantVelocityStartEvaluatesFromItsLastPose)
   EXPECT_EQ(whole.skipped_ground_truth_poses, 0);
   EXPECT_EQ(whole.num_associated, 40);
   EXPECT_GT(whole.rpe_cm_s, 5.0);
-  EvaluationOptions skip;
-  skip.skip_constant_velocity_start = true;
-  const EvaluationResult skipped = EvaluateTrajectory(gt, est, skip);
+  const EvaluationResult skipped = EvaluateTrajectory(gt, est, SkippingConstantVelocityStart());
   EXPECT_EQ(skipped.constant_velocity_start_poses, 15);
   EXPECT_EQ(skipped.skipped_ground_truth_poses, 14);
   EXPECT_EQ(skipped.num_associated, 26);
