@@ -22,7 +22,7 @@
 # Sequences (scripts/dev_set.sh) are rendered into OUT/seq_f<frames>/ and kept; runs already in OUT are kept (pldvo
 # ablate --skip_existing), so an interrupted benchmark resumes. The runs map inline
 # (odometry.parallel_mapping=false; the same results as the mapping thread, odometry.mapping_lag).
-# The full set (12 families x 3 seeds + 2 real, x 2 configs x 8 maps, 300 frames) is about 610
+# The full set (13 families x 3 seeds + 2 real, x 2 configs x 8 maps, 300 frames) is about 660
 # runs: hours on 2 cores.
 set -euo pipefail
 if [ $# -ne 1 ]; then

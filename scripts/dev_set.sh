@@ -21,6 +21,7 @@ dev_set_families=(
   "checkerboard|--preset checkerboard"
   "boxes|--preset boxes"
   "handheld|--preset handheld"
+  "pivot|--preset handheld --set pivot_distance=0.25"
 )
 
 dev_set_datasets() {

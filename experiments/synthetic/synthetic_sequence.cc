@@ -74,6 +74,7 @@ CameraPath DrawPath(const Scene& scene, const SynthOptions& options, double ampl
   const double center_dy = rng->Uniform(-0.3, 0.3);
   const double center_dx = rng->Uniform(-0.3, 0.3);
   path.center = Eigen::Vector3d(0.5 * room.x() + center_dx, 0.5 * room.y() + center_dy, center_z);
+  path.pivot_distance = options.pivot_distance;
   // Furniture reaches 0.65 m from a wall; the path keeps about 1.2 m from the walls.
   const double budget[3] = {std::max(0.1, 0.5 * room.x() - 1.2) * amplitude_scale,
                             std::max(0.1, 0.5 * room.y() - 1.2) * amplitude_scale, 0.15};
@@ -271,6 +272,7 @@ std::string SynthOptions::Check() const {
     return "pitch_amplitude, roll_amplitude: must be < 1 rad";
   }
   if (!(jitter_deg < 5.0)) return "jitter_deg: must be < 5";
+  if (!(pivot_distance >= 0.0 && pivot_distance <= 2.0)) return "pivot_distance: must be in [0, 2]";
   if (!(ambient >= 0.0) || !(light_intensity >= 0.0)) {
     return "ambient, light_intensity: must be >= 0";
   }
@@ -340,7 +342,8 @@ SE3 CameraPath::WorldFromCam(double time) const {
   world_from_cam_rotation << right, down, forward;
   world_from_cam_rotation = world_from_cam_rotation *
                             Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  return SE3(world_from_cam_rotation, PositionInWorld(time));
+  return SE3(world_from_cam_rotation,
+             PositionInWorld(time) + pivot_distance * world_from_cam_rotation.col(2));
 }
 
 Lighting LightingAt(const SyntheticSequence& sequence, double time) {

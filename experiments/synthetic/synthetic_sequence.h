@@ -67,6 +67,7 @@ struct SynthOptions {
   double pitch_amplitude = -1.0;  // rad, pitch swing of the path; < 0: preset (0.2, handheld 0.35)
   double roll_amplitude = -1.0;   // rad, roll swing of the path; < 0: preset (0.07, handheld 0.3)
   double jitter_deg = -1.0;       // hand tremor per axis, 4-10 Hz; < 0: preset (handheld 0.15)
+  double pivot_distance = 0.0;    // m; the camera turns about a point this far behind its centre
   double ambient = 0.35;          // ambient term of the shading (albedo 1 -> 255 * ambient)
   double light_intensity = 0.75;  // point-light term at normal incidence, 2.5 m away
   double min_depth = 0.5;         // metres: every pixel of every frame sees at least this far
@@ -137,6 +138,10 @@ struct SynthOptions {
     v.Field("jitter_deg", &jitter_deg,
             "Hand tremor: per-axis rotation jitter amplitude in degrees at 4-10 Hz; < 0: preset "
             "(handheld 0.15, else 0).");
+    v.Field("pivot_distance", &pivot_distance,
+            "Metres behind the optical centre of the point the camera turns about (a wrist, a "
+            "car's rear axle: turning moves the centre); 0: turns about its centre. The mean "
+            "speed cannot drop below what the turns alone give.");
     v.Field("ambient", &ambient, "Ambient shading term.");
     v.Field("light_intensity", &light_intensity,
             "Point-light shading term at normal incidence and 2.5 m distance.");
@@ -276,6 +281,8 @@ struct CameraPath {
   double angle_amp[3][kTerms] = {}, angle_freq[3][kTerms] = {}, angle_phase[3][kTerms] = {};
   // Hand tremor: one fast sinusoid per angle (rad, rad/s), not rescaled with the motion.
   double jitter_amp[3] = {}, jitter_freq[3] = {}, jitter_phase[3] = {};
+  // The camera centre is this far ahead of PositionInWorld along its optical axis, m.
+  double pivot_distance = 0.0;
   Eigen::Vector3d PositionInWorld(double time) const;
   // yaw, pitch, roll (tremor included).
   Eigen::Vector3d Angles(double time) const;
