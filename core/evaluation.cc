@@ -288,6 +288,11 @@ std::vector<FrameMotionError> EvaluateFrameMotion(const Trajectory& ground_truth
                              gt_motion.translation().dot(est_motion.translation()))
             : kNaN;
     error.translation_ratio = gt_length > 0.0 ? scale * est_length / gt_length : kNaN;
+    const Eigen::Vector3d gt_rotation = LogSO3(gt_motion.rotation_matrix());
+    const Eigen::Vector3d est_rotation = LogSO3(est_motion.rotation_matrix());
+    error.true_rotation_deg = kDegPerRad * gt_rotation.norm();
+    error.rotation_along_true_deg =
+        gt_rotation.norm() > 0.0 ? kDegPerRad * est_rotation.dot(gt_rotation.normalized()) : 0.0;
     errors.push_back(error);
   }
   return errors;
@@ -297,14 +302,26 @@ void WriteFrameMotionErrorsCsv(const std::vector<FrameMotionError>& errors, std:
   const auto number = [&out](double value) -> std::ostream& {
     return std::isnan(value) ? out << "nan" : out << value;
   };
-  out << "timestamp,rotation_error_deg,translation_direction_error_deg,translation_ratio\n";
+  out << "timestamp,rotation_error_deg,translation_direction_error_deg,translation_ratio,"
+         "true_rotation_deg,rotation_along_true_deg\n";
   out << std::setprecision(9);
   for (const FrameMotionError& error : errors) {
     out << error.timestamp << ",";
     number(error.rotation_error_deg) << ",";
     number(error.translation_direction_error_deg) << ",";
-    number(error.translation_ratio) << "\n";
+    number(error.translation_ratio) << ",";
+    number(error.true_rotation_deg) << ",";
+    number(error.rotation_along_true_deg) << "\n";
   }
+}
+
+double PooledRotationRatio(const std::vector<FrameMotionError>& errors) {
+  double along = 0.0, truth = 0.0;
+  for (const FrameMotionError& error : errors) {
+    along += error.rotation_along_true_deg;
+    truth += error.true_rotation_deg;
+  }
+  return truth > 0.0 ? along / truth : std::numeric_limits<double>::quiet_NaN();
 }
 
 }  // namespace pldvo

@@ -122,7 +122,15 @@ struct FrameMotionError {
   // scale |t_est| / |t_gt| (1: the motion's length agrees at the alignment's scale); NaN when the
   // ground truth does not move.
   double translation_ratio = 0.0;
+  double true_rotation_deg = 0.0;  // angle of R_gt
+  // The estimated rotation vector log(R_est) along the true axis log(R_gt) / |log(R_gt)|, deg (0
+  // when the ground truth does not turn): over the true angle, how much of the turn is tracked.
+  double rotation_along_true_deg = 0.0;
 };
+
+// sum rotation_along_true_deg / sum true_rotation_deg over `errors`: the estimate's turns over
+// the true ones (1: no over- or under-rotation); NaN when the ground truth does not turn.
+double PooledRotationRatio(const std::vector<FrameMotionError>& errors);
 
 // One entry per pair of consecutive estimate poses that both have a ground-truth pose: the one
 // stamped with the same time, or the interpolation between the two around it when they are at

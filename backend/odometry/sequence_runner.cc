@@ -383,6 +383,7 @@ void AddFrameMotionErrors(const Trajectory& ground_truth, const Trajectory& esti
   };
   (*summary)["motion_rotation_error_deg_median"] = NumberOrNull(median_or_nan(rotation));
   (*summary)["motion_direction_error_deg_median"] = NumberOrNull(median_or_nan(direction));
+  (*summary)["motion_rotation_ratio"] = NumberOrNull(PooledRotationRatio(errors));
 }
 
 // OUT/trajectory.svg: the estimate, Sim(3)-aligned when there is ground truth, over it.

@@ -1,5 +1,6 @@
-// `pldvo eval --gt FILE --est FILE [--json] [--motion_errors CSV]`: ATE, RPE, coverage and scale
-// drift of an estimated trajectory against ground truth, both in TUM format (docs/evaluation.md).
+// `pldvo eval --gt FILE --est FILE [--json] [--motion_errors CSV]`: ATE, RPE, coverage, scale
+// drift and the pooled rotation ratio of an estimated trajectory against ground truth, both in TUM
+// format (docs/evaluation.md).
 // `--set key=value` sets the EvaluationOptions (max_time_diff, rpe_delta, align_scale,
 // scale_window, constant_velocity_tolerance, skip_constant_velocity_start).
 #include <gflags/gflags.h>
@@ -10,6 +11,7 @@
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "core/config_io.h"
 #include "core/evaluation.h"
@@ -43,10 +45,12 @@ int RunEval(const CommandContext& context) {
     const Trajectory ground_truth = ReadTrajectoryTum(FLAGS_gt);
     const Trajectory estimate = ReadTrajectoryTum(FLAGS_est);
     const EvaluationResult result = EvaluateTrajectory(ground_truth, estimate, options);
+    const std::vector<FrameMotionError> motion_errors =
+        EvaluateFrameMotion(ground_truth, estimate, result.scale, options.max_time_diff);
+    const double rotation_ratio = PooledRotationRatio(motion_errors);
     if (!FLAGS_motion_errors.empty()) {
       std::ofstream file(FLAGS_motion_errors);
-      WriteFrameMotionErrorsCsv(
-          EvaluateFrameMotion(ground_truth, estimate, result.scale, options.max_time_diff), file);
+      WriteFrameMotionErrorsCsv(motion_errors, file);
       if (!file) throw std::runtime_error("cannot write " + FLAGS_motion_errors);
     }
     if (FLAGS_json) {
@@ -64,6 +68,7 @@ int RunEval(const CommandContext& context) {
       json["num_ground_truth"] = ground_truth.size();
       json["ground_truth_constant_velocity_start"] = result.constant_velocity_start_poses;
       json["skipped_ground_truth_poses"] = result.skipped_ground_truth_poses;
+      json["rotation_ratio"] = NumberOrNull(rotation_ratio);
       std::cout << json.dump() << "\n";
       return 0;
     }
@@ -72,6 +77,7 @@ int RunEval(const CommandContext& context) {
               << "RPE translation:           " << std::setprecision(3) << result.rpe_cm_s
               << " cm/s  (delta " << options.rpe_delta << " s, " << result.num_pairs << " pairs)\n"
               << "RPE rotation:              " << result.rpe_deg_s << " deg/s\n"
+              << "rotation ratio (est / gt): " << rotation_ratio << "\n"
               << "scale (gt per est unit):   " << std::setprecision(6) << result.scale << "\n"
               << "coverage:                  " << std::setprecision(3) << result.coverage << "  ("
               << result.num_associated << " of " << estimate.size()

@@ -341,8 +341,37 @@ TEST(EvaluateFrameMotion, ReportsTheAngleBetweenTranslationsAndSkipsPosesWithout
   std::ostringstream csv;
   WriteFrameMotionErrorsCsv(errors, csv);
   EXPECT_EQ(csv.str().substr(0, csv.str().find('\n')),
-            "timestamp,rotation_error_deg,translation_direction_error_deg,translation_ratio");
-  EXPECT_NE(csv.str().find("0.4,0,nan,nan\n"), std::string::npos) << csv.str();
+            "timestamp,rotation_error_deg,translation_direction_error_deg,translation_ratio,"
+            "true_rotation_deg,rotation_along_true_deg");
+  EXPECT_NE(csv.str().find("0.4,0,nan,nan,0,0\n"), std::string::npos) << csv.str();
+  // Nothing turns: no rotation ratio.
+  EXPECT_TRUE(std::isnan(PooledRotationRatio(errors)));
+}
+
+TEST(EvaluateFrameMotion, TheRotationRatioIsTheTrackedShareOfTheTrueTurns) {
+  // gt turns 3 deg per frame about an axis tilted from z; est turns 3.3 deg per frame about the
+  // same axis (10% over-rotated) plus 0.5 deg per frame about a perpendicular axis, which adds to
+  // the rotation error but not to the rotation along the true axis.
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.2, -0.3, 1.0).normalized();
+  const Eigen::Vector3d across = axis.cross(Eigen::Vector3d::UnitX()).normalized();
+  const double deg = M_PI / 180.0;
+  Trajectory gt, est;
+  Eigen::Quaterniond q_gt = Eigen::Quaterniond::Identity(), q_est = q_gt;
+  for (int i = 0; i < 6; ++i) {
+    gt.push_back(Pose(0.1 * i, Eigen::Vector3d(0.1 * i, 0, 0), q_gt));
+    est.push_back(Pose(0.1 * i, Eigen::Vector3d(0.1 * i, 0, 0), q_est));
+    q_gt = q_gt * Eigen::AngleAxisd(3.0 * deg, axis);
+    // Rotation vector 3.3 deg along the axis and 0.5 deg across it.
+    const Eigen::Vector3d step = (3.3 * axis + 0.5 * across) * deg;
+    q_est = q_est * Eigen::AngleAxisd(step.norm(), step.normalized());
+  }
+  const std::vector<FrameMotionError> errors = EvaluateFrameMotion(gt, est, 1.0, 0.02);
+  ASSERT_EQ(errors.size(), 5u);
+  for (const FrameMotionError& error : errors) {
+    EXPECT_NEAR(error.true_rotation_deg, 3.0, 1e-9);
+    EXPECT_NEAR(error.rotation_along_true_deg, 3.3, 1e-9);
+  }
+  EXPECT_NEAR(PooledRotationRatio(errors), 1.1, 1e-9);
 }
 
 TEST(EvaluateFrameMotion, InterpolatesTheGroundTruthAtTheEstimateTimestamps) {

@@ -126,15 +126,15 @@ TEST(RunCommandTest, WritesAllOutputs) {
       EXPECT_GE(summary[object][key].get<double>(), 0.0);
     }
   }
-  for (const char* key :
-       {"rpe_cm_s", "rpe_deg_s", "ate_m", "coverage", "scale_drift",
-        "motion_rotation_error_deg_median", "motion_direction_error_deg_median"}) {
+  for (const char* key : {"rpe_cm_s", "rpe_deg_s", "ate_m", "coverage", "scale_drift",
+                          "motion_rotation_error_deg_median", "motion_direction_error_deg_median",
+                          "motion_rotation_ratio"}) {
     EXPECT_TRUE(summary[key].is_number()) << key;
   }
   // motion_errors.csv: a header and one row per motion between consecutive tracked frames.
   EXPECT_EQ(CountLines(out / "motion_errors.csv", false), kFrames);
   for (const std::vector<std::string>& row : CsvRows(out / "motion_errors.csv")) {
-    ASSERT_EQ(row.size(), 4u);
+    ASSERT_EQ(row.size(), 6u);
     EXPECT_GE(std::stod(row[1]), 0.0);
   }
   ASSERT_TRUE(summary["window_scales"].is_array());
