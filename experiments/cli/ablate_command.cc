@@ -298,7 +298,7 @@ int RunAblate(const CommandContext& context) {
     std::ofstream csv(out + "/results.csv");
     csv << "dataset,config,status,frames,tracked,keyframes,lost_events,rpe_cm_s,rpe_deg_s,ate_m,"
            "coverage,scale_drift,ms_median_tracking_thread,ms_median_total,init_seed,dir,"
-           "scale_segments,motion_direction_error_deg_median\n";
+           "scale_segments,motion_direction_error_deg_median,motion_rotation_ratio\n";
     for (const Pair& pair : pairs) {
       const nlohmann::json& s = summaries[pair.index];
       auto integer = [&](const char* key) {
@@ -316,7 +316,8 @@ int RunAblate(const CommandContext& context) {
           << Fixed(JsonNumber(ms, "tracking_thread"), 2) << "," << Fixed(JsonNumber(ms, "total"), 2)
           << "," << (repeats > 1 ? std::to_string(pair.repeat) : std::string()) << "," << pair.dir
           << "," << integer("scale_segments") << ","
-          << Fixed(JsonNumber(s, "motion_direction_error_deg_median"), 2) << "\n";
+          << Fixed(JsonNumber(s, "motion_direction_error_deg_median"), 2) << ","
+          << Fixed(JsonNumber(s, "motion_rotation_ratio"), 4) << "\n";
     }
   }
   {
@@ -392,6 +393,10 @@ int RunAblate(const CommandContext& context) {
         "Translation direction error of the frame-to-frame motions (deg, median over the frames; "
         "docs/evaluation.md)",
         "motion_direction_error_deg_median", 1);
+    table(
+        "Rotation ratio (estimated / true turning of the frame-to-frame motions; "
+        "docs/evaluation.md)",
+        "motion_rotation_ratio", 3);
     // With odometry.parallel_mapping false the tracking thread also runs every mapping job.
     const bool inline_mapping = std::any_of(summaries.begin(), summaries.end(), [](const auto& s) {
       return s.is_object() && s.contains("parallel_mapping") && s["parallel_mapping"] == false;

@@ -431,9 +431,12 @@ TEST(AblateCommandTest, TinyGridWritesTablesAndPlot) {
                       0),
             0u)
       << csv;
-  // The scale segments and the motion direction error close the header (appended: scripts read
-  // the columns by position), and neither run of this short sequence re-initialises.
-  EXPECT_NE(csv.find(",dir,scale_segments,motion_direction_error_deg_median\n"), std::string::npos)
+  // The scale segments, the motion direction error and the rotation ratio close the header
+  // (appended: scripts read the columns by position), and neither run of this short sequence
+  // re-initialises.
+  EXPECT_NE(
+      csv.find(",dir,scale_segments,motion_direction_error_deg_median,motion_rotation_ratio\n"),
+      std::string::npos)
       << csv;
   EXPECT_NE(csv.find("/lowtex__sdvo,1,"), std::string::npos) << csv;
   // results.md: the RPE table with one row for the sequence and a column per config.
@@ -541,13 +544,13 @@ TEST(AblateCommandTest, ShardsThenCollectGiveTheResultsOfOneRun) {
   ASSERT_EQ(expected.size(), num_runs);
   ASSERT_EQ(actual.size(), expected.size());
   // Columns: ..., 12 ms_median_tracking_thread, 13 ms_median_total, 14 init_seed, 15 dir,
-  // 16 scale_segments, 17 motion_direction_error_deg_median: all but the times and the run folder
-  // must agree.
+  // 16 scale_segments, 17 motion_direction_error_deg_median, 18 motion_rotation_ratio: all but
+  // the times and the run folder must agree.
   for (size_t row = 0; row < expected.size(); ++row) {
-    ASSERT_EQ(actual[row].size(), 18u);
-    ASSERT_EQ(expected[row].size(), 18u);
+    ASSERT_EQ(actual[row].size(), 19u);
+    ASSERT_EQ(expected[row].size(), 19u);
     EXPECT_EQ(expected[row][2], "ok") << "row " << row;
-    for (size_t column = 0; column < 18; ++column) {
+    for (size_t column = 0; column < 19; ++column) {
       if (column == 12 || column == 13 || column == 15) continue;
       EXPECT_EQ(actual[row][column], expected[row][column])
           << "row " << row << " column " << column;
