@@ -185,7 +185,7 @@ struct OdometryOptions {
   bool two_view_bootstrap = true;
   double two_view_min_parallax_deg = 2.0;
   double two_view_min_rotation_free_parallax_px = 3.0;
-  int two_view_min_inliers = 50;
+  int two_view_min_inliers = 30;
   int two_view_max_frames = 60;
   // Its corners: cv::goodFeaturesToTrack's quality (relative to the strongest corner) and spacing;
   // the second view's adjusted translation direction: its largest standard deviation, and how
@@ -286,7 +286,7 @@ struct OdometryOptions {
             "their rays in frame 0 turned by the best-fitting rotation, times the focal length, "
             "px: below it the essential matrix is fitted to noise (default 3).");
     v.Field("two_view_min_inliers", &two_view_min_inliers,
-            "Two-view bootstrap: triangulated essential-matrix inliers needed (default 50).");
+            "Two-view bootstrap: triangulated essential-matrix inliers needed (default 30).");
     v.Field("two_view_max_frames", &two_view_max_frames,
             "Two-view bootstrap: frames searched for the second view (default 60).");
     v.Field("two_view_corner_quality", &two_view_corner_quality,

@@ -66,6 +66,7 @@ void ExpectExtras(const OdometryConfig& config, bool on, const std::string& name
   EXPECT_EQ(config.odometry.line_outlier_px, on ? 2.0 : 0.0);
   EXPECT_EQ(config.odometry.try_alternatives, on);
   EXPECT_EQ(config.odometry.two_view_bootstrap, on);
+  if (on) EXPECT_EQ(config.odometry.two_view_min_inliers, 30);
   EXPECT_EQ(config.odometry.line_consensus_max_cost_drop, on ? 8.4 : 0.0);
   EXPECT_EQ(config.odometry.random_map_warmup_updates, on ? 3 : 0);
   EXPECT_EQ(config.tracking.problem.weighting.intensity_noise,
@@ -120,7 +121,8 @@ const std::map<std::string, std::function<void(const OdometryConfig&)>>& Cases()
          EXPECT_FALSE(c.odometry.use_lines);
          EXPECT_FALSE(c.mapping.use_line_stereo);
          EXPECT_FALSE(c.mapping.line_regularization);
-         EXPECT_TRUE(c.odometry.two_view_bootstrap);  // the same start as points_lines
+         EXPECT_TRUE(c.odometry.two_view_bootstrap);
+         EXPECT_EQ(c.odometry.two_view_min_inliers, 50);  // points_lines: 30
          EXPECT_EQ(c.tracking.problem.weighting.intensity_noise, NoiseSource::kFixed);
          EXPECT_EQ(c.keyframes.max_rms_growth, 0.0);
        }},
