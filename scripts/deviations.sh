@@ -10,7 +10,7 @@
 # synthetic family at PLDVO_DEV_SEEDS, default "1 2 3", 640x480, and fr1/rpy and KITTI 00 when
 # present), PLDVO_DEV_FRAMES frames (default 300), PLDVO_DEV_FILTER an extended regex on the
 # sequence names. Both: PLDVO_DEV_REPEATS initial maps (default 3; mapping.init_seed 1..R),
-# inline mapping (deterministic), PLDVO_DEV_JOBS runs at a time. The full set is 42 configs x 35
+# inline mapping (deterministic), PLDVO_DEV_JOBS runs at a time. The full set is 48 configs x 35
 # sequences x R maps: a cluster job (docs/cluster.md; the grid's configs are in $dir/configs after
 # the first step).
 # Needs python3 with PyYAML (Debian: python3-yaml, which scripts/install_deps.sh installs) to
@@ -73,6 +73,7 @@ residual_noise	mapping.residual_intensity_noise=true	mapping.residual_intensity_
 ambiguity_variance	mapping.ssd_ambiguity_variance=true	mapping.ssd_ambiguity_variance=false	Adds the likelihood-weighted spread of the search's other SSD minima to the variance of an ambiguous match.
 line_ssd_check	mapping.line_stereo_check_ssd=true	mapping.line_stereo_check_ssd=false	Rejects line-guided matches whose 5-sample SSD is too large (a wrong line match).
 line_noise_in_stereo	mapping.line_stereo_estimated_line_noise=true	mapping.line_stereo_estimated_line_noise=false	Scales the current line's position error in eq. 10 by the line noise the tracked frame's point-to-line errors imply (lines noisier than the detector's model, as at low contrast, give less certain depths; docs/mapping.md).
+line_ssd_refine	mapping.line_stereo_ssd=refine_more_precise	mapping.line_stereo_ssd=fallback	Searches the SSD within +- 2 sigma of a line-guided match and takes its match where its variance is the smaller (the line converges, the SSD localises; docs/mapping.md).
 keyframe_line_var	mapping.line_stereo_keyframe_line_var=true	mapping.line_stereo_keyframe_line_var=false	Adds the keyframe line's position error to eq. 10, shared by all of a pixel's line-guided observations.
 ray_1d_regularisation	mapping.line_regularization_method=ray_1d	mapping.line_regularization_method=paper_2d	Fits the line along the pixels' rays in inverse depth with exact inverse-variance weights (no iteration) and a conservative variance (backend/mapping/line_regularizer.h).
 prior_line_gate	odometry.line_prior_gate_px=2	odometry.line_prior_gate_px=0	Unmatches lines whose edge points reproject far from them at the pose prior, before tracking (wrong matches of repetitive patterns).

@@ -23,6 +23,20 @@ DepthMapper::DepthMapper(const PinholeCamera& camera, const MappingOptions& opti
   if (!error.empty()) throw std::invalid_argument("DepthMapper: " + error);
 }
 
+StereoObservation FuseObservations(const StereoObservation& line, const StereoObservation& ssd) {
+  const double line_weight = ssd.idepth_var / (line.idepth_var + ssd.idepth_var);
+  const double ssd_weight = 1.0 - line_weight;
+  StereoObservation fused = ssd;
+  fused.idepth = line_weight * line.idepth + ssd_weight * ssd.idepth;
+  fused.idepth_var = line.idepth_var * line_weight;  // = 1 / (1 / var_line + 1 / var_ssd)
+  fused.disparity_var =
+      line.disparity_var * ssd.disparity_var / (line.disparity_var + ssd.disparity_var);
+  fused.pixel_in_cur = line_weight * line.pixel_in_cur + ssd_weight * ssd.pixel_in_cur;
+  // Only the line's match carries the keyframe edge's shared error, scaled by its weight.
+  fused.shared_idepth_var = line_weight * line_weight * line.shared_idepth_var;
+  return fused;
+}
+
 void FrameUpdateStats::AddCounts(const FrameUpdateStats& other) {
   line_attempts += other.line_attempts;
   line_ok += other.line_ok;
@@ -201,8 +215,8 @@ void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
                       patch_status == StereoStatus::kOk ? &patch : nullptr, &observation);
     if (status == StereoStatus::kOk) {
       ++stats->line_ok;
-      if ((options_.line_stereo_ssd == SsdUse::kRefine ||
-           options_.line_stereo_ssd == SsdUse::kRefineMorePrecise) &&
+      const SsdUse use = options_.line_stereo_ssd;
+      if ((use == SsdUse::kRefine || use == SsdUse::kRefineMorePrecise || use == SsdUse::kFuse) &&
           patch_status == StereoStatus::kOk) {
         const double range = options_.search_sigmas * std::sqrt(observation.idepth_var);
         StereoObservation refined;
@@ -210,9 +224,8 @@ void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
                               std::max(idepth_min, observation.idepth - range),
                               std::min(idepth_max, observation.idepth + range), options_,
                               &refined) == StereoStatus::kOk &&
-            (options_.line_stereo_ssd == SsdUse::kRefine ||
-             refined.idepth_var < observation.idepth_var)) {
-          observation = refined;
+            (use != SsdUse::kRefineMorePrecise || refined.idepth_var < observation.idepth_var)) {
+          observation = use == SsdUse::kFuse ? FuseObservations(observation, refined) : refined;
           ++stats->line_refined;
         }
       }

@@ -13,9 +13,10 @@
 // (edge pixels with a matched line: line-guided stereo, eqs. 8-10, for the pixel's foot point on
 // its keyframe line l1 (the ray of a traced pixel up to 1.5 px off l1 misses the 3D line; its
 // nearest edge point is the foot point), falling back to the SSD search when the epipolar line
-// and the edge are nearly parallel; all other pixels: the SSD search over
-// idepth +- 2 sigma) and the observation is fused by the EKF with correlated observation errors
-// (SemiDenseDepthMap::Fuse, options.stereo_error_correlation); pixels
+// and the edge are nearly parallel, and by default (options.line_stereo_ssd) replaced by the SSD
+// search's match within +- 2 sigma of it where that is more precise; all other pixels: the SSD
+// search over idepth +- 2 sigma) and the observation is fused by the EKF with correlated
+// observation errors (SemiDenseDepthMap::Fuse, options.stereo_error_correlation); pixels
 // without a hypothesis are searched over [min_idepth, max_idepth] and initialised from the
 // observation. Then isolated hypotheses are removed and holes filled (depth_regularizer.h).
 // Optionally (options.line_match_max_outside_fraction < 1) a match is left out for the frame when
@@ -45,7 +46,7 @@ namespace pldvo {
 struct FrameUpdateStats {
   int line_attempts = 0;      // edge pixels with a matched line
   int line_ok = 0;            // fused or created from the line-guided match
-  int line_refined = 0;       // of which: refined by the restricted SSD search
+  int line_refined = 0;       // of which: refined (or fused) by the restricted SSD search
   int line_fallback = 0;      // near-parallel: fell back to the SSD search
   int line_rejected = 0;      // out of the prior interval or failed the SSD check
   int line_out_of_range = 0;  // of which: outside the prior interval idepth +- 2 sigma
@@ -69,6 +70,12 @@ struct FrameUpdateStats {
   // Adds the per-pixel counters of `other` (line_* to created, num_edge_pixels).
   void AddCounts(const FrameUpdateStats& other);
 };
+
+// The line-guided match of a pixel and the SSD search's match within its interval
+// (mapping.line_stereo_ssd=fuse) as one observation: the inverse-variance mean of two
+// measurements of one inverse depth with independent errors. Only the line's share of the
+// keyframe edge's error (shared_idepth_var) is common to other frames' observations.
+StereoObservation FuseObservations(const StereoObservation& line, const StereoObservation& ssd);
 
 // FuseLineDepths: what happened to the valid pixels on edges with a line.
 struct LineDepthFusionStats {

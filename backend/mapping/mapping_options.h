@@ -16,7 +16,7 @@ struct MappingOptions {
   enum class Init { kRandom, kConstant };
   enum class OutlierModel { kValidityCounter, kInlierRatio };
   enum class LineRegularizationMethod { kRay1d, kPaper2d };
-  enum class LineStereoSsd { kFallback, kRefine, kRefineMorePrecise, kFirst };
+  enum class LineStereoSsd { kFallback, kRefine, kRefineMorePrecise, kFuse, kFirst };
 
   // ---- Pixel selection.
   // A keyframe pixel gets a depth hypothesis when |grad I| (central differences, gray levels per
@@ -80,12 +80,14 @@ struct MappingOptions {
   // Check the line-guided match photometrically with one 5-sample SSD (max_ssd_rms).
   bool line_stereo_check_ssd = true;
   // How the 5-sample SSD search joins the line-guided stereo on a matched edge's pixel.
-  // kFallback: only where the line-guided match is ill-conditioned. kRefine: also re-search
-  // within the line match's idepth +- search_sigmas sigma_lambda (the line disambiguates, the
-  // SSD localises) and take the SSD's match when that search succeeds; kRefineMorePrecise: only
-  // when its variance is also the smaller one. kFirst: search the whole prior interval first (as
-  // for a pixel without a line); the line-guided match only where that search fails.
-  LineStereoSsd line_stereo_ssd = LineStereoSsd::kFallback;
+  // kFallback (the paper): only where the line-guided match is ill-conditioned. kRefine: also
+  // re-search within the line match's idepth +- search_sigmas sigma_lambda (the line disambiguates,
+  // the SSD localises) and take the SSD's match when that search succeeds; kRefineMorePrecise: only
+  // when its variance is also the smaller one (the default: docs/mapping.md); kFuse: the
+  // inverse-variance mean of both matches (two measurements of one depth with independent errors).
+  // kFirst: search the whole prior interval first (as for a pixel without a line); the line-guided
+  // match only where that search fails.
+  LineStereoSsd line_stereo_ssd = LineStereoSsd::kRefineMorePrecise;
   // Add the keyframe line's perpendicular position error at the pixel (x^T Sigma_l1 x) to the
   // current line's in eq. 10, as a part of the observation's error that every line-guided
   // observation of the pixel shares (the same keyframe detection in every frame).
@@ -236,10 +238,13 @@ struct MappingOptions {
              {{"fallback", LineStereoSsd::kFallback},
               {"refine", LineStereoSsd::kRefine},
               {"refine_more_precise", LineStereoSsd::kRefineMorePrecise},
+              {"fuse", LineStereoSsd::kFuse},
               {"first", LineStereoSsd::kFirst}},
-             "SSD search on matched edges: where the line is ill-conditioned (default), also "
-             "within +- search_sigmas of the line's match (refine, refine_more_precise: if its "
-             "variance is smaller), or over the whole interval before the line (first).");
+             "SSD search on matched edges: only where the line is ill-conditioned (fallback, the "
+             "paper), also within +- search_sigmas of the line's match (refine; "
+             "refine_more_precise, the default: if its variance is smaller; fuse: the "
+             "inverse-variance mean of both), or over the whole interval before the line "
+             "(first).");
     v.Field("line_stereo_keyframe_line_var", &line_stereo_keyframe_line_var,
             "Add the keyframe line's position error to eq. 10, shared by all of the pixel's "
             "line-guided observations (default true).");

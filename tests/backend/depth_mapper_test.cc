@@ -12,7 +12,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -23,6 +25,11 @@
 
 namespace pldvo {
 namespace {
+
+// The line-guided stereo of eqs. 8-10 on its own, the mechanism most TESTs here measure; the SSD
+// refinement of its matches (the default, refine_more_precise) is compared with it in
+// SsdSearchModesOnMatchedEdgesAtOnePixelLineNoise.
+constexpr MappingOptions::LineStereoSsd kLineStereoAlone = MappingOptions::LineStereoSsd::kFallback;
 
 MapEvalConfig SmallConfig() {
   MapEvalConfig config;
@@ -36,6 +43,7 @@ MapEvalConfig SmallConfig() {
   config.line_sigma_px = 0.25;
   config.line_sigma_sweep = {0.1};
   config.speed_repetitions = 0;  // timing belongs in `pldvo mapeval`, not in a test
+  config.mapping.line_stereo_ssd = kLineStereoAlone;
   return config;
 }
 
@@ -47,6 +55,7 @@ MapEvalConfig SequenceConfig(const std::string& preset, int seed) {
   config.synth.threads = 2;
   config.line_sigma_sweep = {};
   config.speed_repetitions = 0;
+  config.mapping.line_stereo_ssd = kLineStereoAlone;
   return config;
 }
 
@@ -101,7 +110,8 @@ TEST(DepthMapperTest, SsdSearchModesOnMatchedEdgesAtOnePixelLineNoise) {
   // match) keeps the line's disambiguation and the SSD's localisation; refine_more_precise
   // replaces the line's match only where refine would and the SSD's variance is also the
   // smaller: fewer replacements; first searches the whole prior interval before the line: the
-  // SSD takes edge pixels the line took, and the edges get about the SSD search's accuracy.
+  // SSD takes edge pixels the line took, and the edges get about the SSD search's accuracy; fuse
+  // averages where refine replaces.
   // Measured (edge median relative error after the 3D line regularisation): fallback 0.0371,
   // refine 0.0111, photometric 0.0115; replacements refine 12426, refine_more_precise 11751;
   // first: line-guided matches 18284 -> 3187, SSD matches 24096 -> 46746, edge error 0.0102.
@@ -113,6 +123,8 @@ TEST(DepthMapperTest, SsdSearchModesOnMatchedEdgesAtOnePixelLineNoise) {
   const MapEvalResult refine = Evaluate(config);
   config.mapping.line_stereo_ssd = MappingOptions::LineStereoSsd::kRefineMorePrecise;
   const MapEvalResult more_precise = Evaluate(config);
+  config.mapping.line_stereo_ssd = MappingOptions::LineStereoSsd::kFuse;
+  const MapEvalResult fuse = Evaluate(config);
   config.mapping.line_stereo_ssd = MappingOptions::LineStereoSsd::kFirst;
   const MapEvalResult first = Evaluate(config);
   auto edge_error = [](const MapEvalRun& run) {
@@ -125,9 +137,45 @@ TEST(DepthMapperTest, SsdSearchModesOnMatchedEdgesAtOnePixelLineNoise) {
   EXPECT_LT(edge_error(refine.line_guided), 1.2 * photometric_error);
   EXPECT_GT(more_precise.line_guided.line_refined, 0);
   EXPECT_LT(more_precise.line_guided.line_refined, refine.line_guided.line_refined);
+  EXPECT_GT(fuse.line_guided.line_refined, 1000);
+  EXPECT_LT(edge_error(fuse.line_guided), 0.5 * edge_error(fallback.line_guided));
   EXPECT_LT(first.line_guided.line_ok, fallback.line_guided.line_ok / 2);
   EXPECT_GT(first.line_guided.ssd_ok, fallback.line_guided.ssd_ok);
   EXPECT_LT(edge_error(first.line_guided), 1.2 * photometric_error);
+}
+
+TEST(DepthMapperTest, FusedLineAndSsdMatchesHaveTheirPredictedVariance) {
+  // Two measurements of one inverse depth, the line's with a part every frame shares (the keyframe
+  // edge) and an independent part, the SSD's independent: the fused estimate's Monte Carlo
+  // variance and its covariance with the line's shared error match FuseObservations' prediction.
+  StereoObservation line, ssd;
+  line.idepth_var = 4e-4;
+  line.shared_idepth_var = 1e-4;
+  line.disparity_var = 0.4;
+  ssd.idepth_var = 1e-4;
+  ssd.disparity_var = 0.1;
+  std::mt19937 rng(5);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  const double truth = 0.5;
+  const int n = 200000;
+  double sum = 0.0, sum_sq = 0.0, sum_shared = 0.0;
+  StereoObservation fused;
+  for (int i = 0; i < n; ++i) {
+    const double shared = std::sqrt(line.shared_idepth_var) * unit(rng);
+    line.idepth = truth + shared + std::sqrt(line.idepth_var - line.shared_idepth_var) * unit(rng);
+    ssd.idepth = truth + std::sqrt(ssd.idepth_var) * unit(rng);
+    fused = FuseObservations(line, ssd);
+    sum += fused.idepth - truth;
+    sum_sq += (fused.idepth - truth) * (fused.idepth - truth);
+    sum_shared += (fused.idepth - truth) * shared;
+  }
+  EXPECT_DOUBLE_EQ(fused.idepth_var, 1.0 / (1.0 / 4e-4 + 1.0 / 1e-4));
+  EXPECT_DOUBLE_EQ(fused.disparity_var, 0.08);
+  EXPECT_NEAR(sum / n, 0.0, 1e-4);
+  EXPECT_NEAR(sum_sq / n / fused.idepth_var, 1.0, 0.02);
+  // Cov(fused, shared) = w_line Var(shared) = sqrt(shared_idepth_var * Var(shared)) here.
+  EXPECT_NEAR(sum_shared / n / std::sqrt(fused.shared_idepth_var * line.shared_idepth_var), 1.0,
+              0.03);
 }
 
 TEST(DepthMapperTest, NeesInSaneBand) {
@@ -438,6 +486,7 @@ TEST(DepthMapperTest, LineMatchContradictedByTheMapIsLeftOut) {
   lines[wrong].line_in_cur.line.z() -= 6.0;  // l = (a, b, c) with a^2 + b^2 = 1
   for (double fraction : {0.5, 1.0}) {
     MappingOptions options;
+    options.line_stereo_ssd = kLineStereoAlone;
     options.line_match_max_outside_fraction = fraction;
     DepthMapper mapper(camera, options);
     mapper.InitializeKeyframeFromDepth(c.keyframe_image, edges.trace, depth, 1e-4);
@@ -473,6 +522,7 @@ TEST(DepthMapperTest, LineMatchesOutsideThePriorIntervalAreDroppedOrLeftToTheGat
   FrameUpdateStats stats[2];
   for (const bool prior_interval : {false, true}) {
     MappingOptions options;
+    options.line_stereo_ssd = kLineStereoAlone;
     options.line_stereo_check_ssd = false;
     options.line_stereo_prior_interval = prior_interval;
     DepthMapper mapper(camera, options);

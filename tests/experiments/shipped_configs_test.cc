@@ -52,6 +52,8 @@ void ExpectExtras(const OdometryConfig& config, bool on, const std::string& name
   EXPECT_EQ(config.mapping.line_stereo_check_ssd, on);
   EXPECT_EQ(config.mapping.line_stereo_keyframe_line_var, on);
   EXPECT_EQ(config.mapping.line_stereo_estimated_line_noise, on);
+  EXPECT_EQ(config.mapping.line_stereo_ssd, on ? MappingOptions::LineStereoSsd::kRefineMorePrecise
+                                               : MappingOptions::LineStereoSsd::kFallback);
   // Off in every config: the paper's behaviour paid on the development set.
   EXPECT_FALSE(config.mapping.line_stereo_prior_interval);
   EXPECT_EQ(config.mapping.line_stereo_min_interval_px, 0.0);
