@@ -35,4 +35,28 @@ bool BetterAlternative(const TrackingResult& a, const TrackingResult& b,
   return AlternativeScore(a, choice) > AlternativeScore(b, choice);
 }
 
+double ImageMotion(const SE3& motion, double mean_idepth) {
+  return motion.Log().tail<3>().norm() + motion.translation().norm() * mean_idepth;
+}
+
+bool BeyondPriorStep(const TrackingResult& alternative, const TrackingResult& first,
+                     const SE3& prior_step, double mean_idepth) {
+  const SE3 alternative_from_first = alternative.cur_from_ref * first.cur_from_ref.Inverse();
+  return ImageMotion(alternative_from_first, mean_idepth) > ImageMotion(prior_step, mean_idepth);
+}
+
+bool AlternativeMayCompete(const TrackingResult& alternative, const TrackingResult& first,
+                           const SE3& prior_step, double mean_idepth,
+                           OdometryOptions::AlternativeChoice choice) {
+  if (choice != OdometryOptions::AlternativeChoice::kMotionGatedInlierRows) return true;
+  if (first.status == TrackingStatus::kLost || alternative.levels.empty() || first.levels.empty()) {
+    return true;
+  }
+  const LevelResult& fa = alternative.levels.back();
+  const LevelResult& ff = first.levels.back();
+  if (!HasCorrelation(fa) || !HasCorrelation(ff)) return true;
+  return !BeyondPriorStep(alternative, first, prior_step, mean_idepth) ||
+         fa.intensity_correlation >= ff.intensity_correlation;
+}
+
 }  // namespace pldvo

@@ -180,6 +180,7 @@ OdometryFrameResult Odometry::Finalize(OdometryFrameResult result) {
   ++stats_.frames;
   stats_.line_term_drops += result.line_term_dropped;
   stats_.line_term_withheld += result.line_term_withheld;
+  stats_.alternatives_gated += result.alternatives_gated > 0;
   const bool tracked = IsTracked(result.status);
   if (tracked) {
     ++stats_.tracked;
@@ -467,7 +468,8 @@ void Odometry::RefreshMap(OdometryTiming* timing) {
 
 TrackingResult Odometry::TrackWithAlternatives(const ImagePyramid& pyramid, const cv::Mat& image,
                                                int index, const SE3& prior_cur_from_kf,
-                                               const SE3& last_good_cur_from_kf, int* tried) {
+                                               const SE3& last_good_cur_from_kf,
+                                               OdometryFrameResult* frame_result) {
   TrackingIterationCallback callback;
   if (observer_ != nullptr && observer_->WantsTrackingIterations(index)) {
     callback = [this, index, &image](const TrackingIteration& iteration) {
@@ -476,7 +478,7 @@ TrackingResult Odometry::TrackWithAlternatives(const ImagePyramid& pyramid, cons
   }
   TrackingResult best =
       tracker_.Track(reference_, pyramid, prior_cur_from_kf, brightness_, callback);
-  *tried = 1;
+  frame_result->alternatives_tried = 1;
   const OdometryOptions& options = config_.odometry;
   if (!options.try_alternatives || !retry_trigger_.ShouldRetry(best)) return best;
   const double angle = options.alternative_rotation_deg * M_PI / 180.0;
@@ -488,10 +490,18 @@ TrackingResult Odometry::TrackWithAlternatives(const ImagePyramid& pyramid, cons
                         last_good_cur_from_kf);
     }
   }
+  const TrackingResult first = best;
+  const SE3 prior_step = prior_cur_from_kf * last_good_cur_from_kf.Inverse();
   for (const SE3& guess : guesses) {
     TrackingResult result = tracker_.Track(reference_, pyramid, guess, brightness_, callback);
-    ++*tried;
-    if (BetterAlternative(result, best, options.alternative_choice)) best = std::move(result);
+    ++frame_result->alternatives_tried;
+    if (!BetterAlternative(result, best, options.alternative_choice)) continue;
+    if (AlternativeMayCompete(result, first, prior_step, map_->mean_idepth,
+                              options.alternative_choice)) {
+      best = std::move(result);
+    } else {
+      ++frame_result->alternatives_gated;
+    }
   }
   return best;
 }
@@ -624,8 +634,8 @@ TrackingResult Odometry::TrackFrame(const ImagePyramid& pyramid, const cv::Mat& 
         RemoveLineOutliers(prior_cur_from_kf, config_.odometry.line_prior_gate_px, &reference_,
                            &association->lines_in_cur);
   }
-  TrackingResult tracking = TrackWithAlternatives(
-      pyramid, image, index, prior_cur_from_kf, last_good_cur_from_kf, &result->alternatives_tried);
+  TrackingResult tracking = TrackWithAlternatives(pyramid, image, index, prior_cur_from_kf,
+                                                  last_good_cur_from_kf, result);
   if (config_.odometry.line_outlier_px > 0.0 && line_term &&
       tracking.status != TrackingStatus::kLost) {
     const int outliers = RemoveLineOutliers(tracking.cur_from_ref, config_.odometry.line_outlier_px,

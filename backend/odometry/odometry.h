@@ -83,6 +83,7 @@ struct OdometryStatistics {
   int edge_ba_line_depth_outliers = 0;
   int line_term_drops = 0;     // frames whose line term the consensus check dropped
   int line_term_withheld = 0;  // frames tracked without it (random_map_warmup_updates)
+  int alternatives_gated = 0;  // frames where the motion gate kept out a winning alternative
   // backend.windowed_ba: windows solved, applied (moved the keyframe poses), solves that threw,
   // depth-correction jobs sent to the mapping thread and the hypotheses they shifted, windows
   // solved with a marginalisation prior (marginalize).
@@ -205,7 +206,8 @@ class Odometry {
   void RefreshMap(OdometryTiming* timing);
   TrackingResult TrackWithAlternatives(const ImagePyramid& pyramid, const cv::Mat& image, int index,
                                        const SE3& prior_cur_from_kf,
-                                       const SE3& last_good_cur_from_kf, int* tried);
+                                       const SE3& last_good_cur_from_kf,
+                                       OdometryFrameResult* result);
   SE3 PredictWorldFromCam(int index) const;
   // Edge BA: adds the new keyframe to the window (previous_segment: see
   // KeyframeWindow::AddKeyframe; old_from_new: its tracked pose relative to the previous

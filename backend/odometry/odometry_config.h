@@ -122,14 +122,21 @@ struct OdometryOptions {
   // over recent tracked frames (backend/odometry/retry_trigger.h): zero motion since the last good
   // frame, and that pose rotated by +-alternative_rotation_deg about the camera's x and y axes.
   // The best non-lost result wins by alternative_choice (backend/odometry/alternative_choice.h):
-  // the most inlier rows at the finest level, the most inlier rows times the intensity
-  // correlation of its photometric rows, or more inlier rows and a correlation no lower (a wrong
-  // pose can gain inlier rows where the images no longer correlate).
+  // the most inlier rows at the finest level, where an alternative that ends further from the
+  // first result than the prior moves the camera over the frame also needs a correlation no
+  // lower (the default: a repetitive pattern's neighbouring period gains rows, not correlation);
+  // or the most inlier rows alone, or times the intensity correlation, or more inlier rows and a
+  // correlation no lower (a wrong pose can gain inlier rows where the images no longer correlate).
   bool try_alternatives = true;
   double retry_rms_ratio = 1.5;
   double alternative_rotation_deg = 2.0;
-  enum class AlternativeChoice { kInlierRows, kCorrelatedInlierRows, kRowsAndCorrelation };
-  AlternativeChoice alternative_choice = AlternativeChoice::kInlierRows;
+  enum class AlternativeChoice {
+    kInlierRows,
+    kCorrelatedInlierRows,
+    kRowsAndCorrelation,
+    kMotionGatedInlierRows
+  };
+  AlternativeChoice alternative_choice = AlternativeChoice::kMotionGatedInlierRows;
   // Lost tracking: a lost frame gets the constant-velocity extrapolation of the last good pose
   // (marked lost, not mapped). After this many consecutive lost frames the odometry
   // re-initialises: the current frame becomes a keyframe at the extrapolated pose, with the old
@@ -241,10 +248,13 @@ struct OdometryOptions {
     v.Choice("alternative_choice", &alternative_choice,
              {{"inlier_rows", AlternativeChoice::kInlierRows},
               {"correlated_inlier_rows", AlternativeChoice::kCorrelatedInlierRows},
-              {"rows_and_correlation", AlternativeChoice::kRowsAndCorrelation}},
+              {"rows_and_correlation", AlternativeChoice::kRowsAndCorrelation},
+              {"motion_gated_inlier_rows", AlternativeChoice::kMotionGatedInlierRows}},
              "Which retried result wins: inlier_rows (most inlier rows) | correlated_inlier_rows "
              "(inlier rows x intensity correlation) | rows_and_correlation (more inlier rows and "
-             "a correlation no lower) (default inlier_rows).");
+             "a correlation no lower) | motion_gated_inlier_rows (inlier_rows; an alternative "
+             "further from the first result than the prior's motion over the frame also needs a "
+             "correlation no lower) (default motion_gated_inlier_rows).");
     v.Field("reinit_after_lost", &reinit_after_lost,
             "Consecutive lost frames before re-initialising at the current frame (default 3).");
     v.Field("reinit_min_points", &reinit_min_points,

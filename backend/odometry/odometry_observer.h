@@ -59,6 +59,8 @@ struct OdometryFrameResult {
   int keyframe_id = -1;     // the keyframe the frame was tracked against / became
   TrackingResult tracking;  // the chosen tracking result (empty levels when not tracked)
   int alternatives_tried = 0;
+  // Alternatives that would have won but motion_gated_inlier_rows kept out.
+  int alternatives_gated = 0;
   int num_lines = 0;    // line segments of the frame
   int num_matches = 0;  // matched to the keyframe
   // odometry.line_consensus_max_cost_drop: the line term disagreed with the photometric one and

@@ -517,6 +517,7 @@ SequenceRunResult SequenceRunner::Run() {
   summary["scale_segments"] = stats.scale_segments;
   summary["line_term_drops"] = stats.line_term_drops;
   summary["line_term_withheld"] = stats.line_term_withheld;
+  summary["alternatives_gated"] = stats.alternatives_gated;
   summary["dropped_mapping_updates"] = stats.dropped_mapping_updates;
   summary["failed_mapping_jobs"] = stats.failed_mapping_jobs;
   summary["parallel_mapping"] = config_.odometry.parallel_mapping;

@@ -67,6 +67,10 @@ void ExpectExtras(const OdometryConfig& config, bool on, const std::string& name
   EXPECT_EQ(config.odometry.line_prior_gate_px, on ? 2.0 : 0.0);
   EXPECT_EQ(config.odometry.line_outlier_px, on ? 2.0 : 0.0);
   EXPECT_EQ(config.odometry.try_alternatives, on);
+  if (on) {
+    EXPECT_EQ(config.odometry.alternative_choice,
+              OdometryOptions::AlternativeChoice::kMotionGatedInlierRows);
+  }
   EXPECT_EQ(config.odometry.two_view_bootstrap, on);
   if (on) EXPECT_EQ(config.odometry.two_view_min_inliers, 30);
   EXPECT_EQ(config.odometry.line_consensus_max_cost_drop, on ? 8.4 : 0.0);
