@@ -207,7 +207,7 @@ class Odometry {
   TrackingResult TrackWithAlternatives(const ImagePyramid& pyramid, const cv::Mat& image, int index,
                                        const SE3& prior_cur_from_kf,
                                        const SE3& last_good_cur_from_kf,
-                                       OdometryFrameResult* result);
+                                       OdometryFrameResult* frame_result);
   SE3 PredictWorldFromCam(int index) const;
   // Edge BA: adds the new keyframe to the window (previous_segment: see
   // KeyframeWindow::AddKeyframe; old_from_new: its tracked pose relative to the previous
