@@ -63,6 +63,8 @@ std::string OdometryOptions::Check() const {
   if (!(two_view_photometric_outlier_factor >= 0.0)) {
     return "two_view_photometric_outlier_factor must be >= 0";
   }
+  if (random_start_candidates < 1) return "random_start_candidates must be >= 1";
+  if (random_start_frames < 2) return "random_start_frames must be >= 2";
   return "";
 }
 

@@ -207,6 +207,13 @@ struct OdometryOptions {
   // the map estimated again from the refined poses. 0 passes: the corners' poses only.
   int two_view_photometric_passes = 1;
   double two_view_photometric_outlier_factor = 0.0;
+  // Best of several random starts (backend/odometry/random_start_choice.h), monocular runs that
+  // start from the random map (no two-view start): the first random_start_frames frames run from
+  // random_start_candidates initial maps (mapping.init_seed, + 1000 per further candidate) and
+  // the run starts from the one whose frames fit best (fewest not tracked, then the highest mean
+  // intensity correlation). 1 = the one map of mapping.init_seed (paper.yaml).
+  int random_start_candidates = 3;
+  int random_start_frames = 60;
   // Solver comparison (docs/tracking.md): every tracked frame's final tracking problem (the same
   // reference, lines and initial pose) is solved a second time with this solver; its poses, RPE
   // and time are reported beside the run's (summary.json `compare_solver`,
@@ -318,6 +325,12 @@ struct OdometryOptions {
     v.Field("two_view_photometric_outlier_factor", &two_view_photometric_outlier_factor,
             "Two-view bootstrap: the photometric refinement leaves out a point's frame whose "
             "energy exceeds factor^2 x the median (DSO's outlier test; 0 = off, default 0).");
+    v.Field(
+        "random_start_candidates", &random_start_candidates,
+        "Monocular runs from the random map: initial maps tried over the first "
+        "random_start_frames frames; the run starts from the best fitting (1 = off; default 3).");
+    v.Field("random_start_frames", &random_start_frames,
+            "Frames each random-start candidate runs before the choice (default 60).");
     v.Choice("compare_solver", &compare_solver,
              ChoiceNames<CompareSolver>{{"none", CompareSolver::kNone},
                                         {"ceres", CompareSolver::kCeres},

@@ -26,6 +26,7 @@
 #include "backend/odometry/frame_preparer.h"
 #include "backend/odometry/live_frame_source.h"
 #include "backend/odometry/odometry.h"
+#include "backend/odometry/random_start_choice.h"
 #include "backend/odometry/solver_comparison.h"
 #include "backend/odometry/two_view_bootstrap.h"
 #include "core/config_io.h"
@@ -143,14 +144,16 @@ class RunFiles {
 // Where the run starts: the config it runs with and frame 0's depth, from the bootstraps.
 struct InitialMap {
   OdometryConfig run_config;
-  cv::Mat depth;             // frame 0's z-depth (empty: the dataset's or a random map)
-  nlohmann::json bootstrap;  // summary.json `bootstrap` (null when not run)
-  nlohmann::json two_view;   // summary.json `two_view_bootstrap` (null when not run)
+  cv::Mat depth;                // frame 0's z-depth (empty: the dataset's or a random map)
+  nlohmann::json bootstrap;     // summary.json `bootstrap` (null when not run)
+  nlohmann::json two_view;      // summary.json `two_view_bootstrap` (null when not run)
+  nlohmann::json random_start;  // summary.json `random_start` (null when not run)
 };
 
 // odometry.bootstrap_passes > 1 starts from the refined first map, odometry.init_depth_idepth_var
 // > 0 from the dataset's depth, otherwise odometry.two_view_bootstrap from the map of the two-view
-// geometry; a bootstrap that fails falls back to the random map, said so.
+// geometry; a bootstrap that fails falls back to the random map, said so, whose initial values
+// odometry.random_start_candidates > 1 chooses among several.
 InitialMap PrepareInitialMap(const Dataset& dataset, const OdometryConfig& config, int num_frames) {
   InitialMap initial;
   initial.run_config = config;
@@ -195,6 +198,30 @@ InitialMap PrepareInitialMap(const Dataset& dataset, const OdometryConfig& confi
                 << two_view.points << " hypotheses, " << static_cast<int>(two_view.ms) << " ms\n";
     } catch (const std::exception& e) {
       std::cerr << "pldvo run: " << e.what() << "; the run starts from the random map\n";
+    }
+  }
+  if (initial.depth.empty() && initial.run_config.odometry.init_depth_idepth_var <= 0.0 &&
+      config.odometry.random_start_candidates > 1 && num_frames > 1) {
+    try {
+      const RandomStartChoice choice = ChooseRandomStart(dataset, initial.run_config, num_frames);
+      initial.run_config.mapping.init_seed = choice.init_seed;
+      nlohmann::json candidates = nlohmann::json::array();
+      for (const RandomStartCandidate& c : choice.candidates) {
+        candidates.push_back({{"init_seed", c.init_seed},
+                              {"untracked", c.untracked},
+                              {"mean_correlation", c.mean_correlation},
+                              {"mean_rms", c.mean_rms}});
+      }
+      initial.random_start = {{"init_seed", choice.init_seed},
+                              {"frames", choice.frames},
+                              {"candidates", candidates},
+                              {"ms", choice.ms}};
+      std::cerr << "pldvo run: random start: mapping.init_seed " << choice.init_seed << " of "
+                << choice.candidates.size() << " initial maps fits frames 1-" << choice.frames - 1
+                << " best, " << static_cast<int>(choice.ms) << " ms\n";
+    } catch (const std::exception& e) {
+      std::cerr << "pldvo run: random start choice failed (" << e.what()
+                << "); the run starts from mapping.init_seed " << config.mapping.init_seed << "\n";
     }
   }
   return initial;
@@ -533,6 +560,8 @@ SequenceRunResult SequenceRunner::Run() {
   // the two-view bootstrap's second view, triangulated corners, parallax and hypotheses.
   summary["bootstrap"] = initial.bootstrap;
   summary["two_view_bootstrap"] = initial.two_view;
+  // odometry.random_start_candidates: the initial maps tried and the one the run started from.
+  summary["random_start"] = initial.random_start;
   summary["fps"] = run_seconds > 0.0 ? num_frames / run_seconds : 0.0;
   // Edge bundle adjustment (backend.edge_ba): windows solved, applied, CPU ms per window, and
   // the line-depth feedback (backend.edge_ba.line_depth_feedback, docs/edge_ba.md).

@@ -117,8 +117,8 @@ struct RunResult {
   std::string log;     // stdout and stderr
 };
 
-// Runs `pldvo run --dataset DATASET --out OUT` (deterministic mapping) plus `extra`, under
-// `timeout`; OUT is TestRoot()/name.
+// Runs `pldvo run --dataset DATASET --out OUT` (deterministic mapping, one random start) plus
+// `extra`, under `timeout`; OUT is TestRoot()/name.
 RunResult RunPldvo(const fs::path& dataset, const std::string& name,
                    const std::string& extra = "") {
   std::string log_name = name + ".log";
@@ -127,7 +127,8 @@ RunResult RunPldvo(const fs::path& dataset, const std::string& name,
   const std::string command =
       "timeout -k 5 " + std::to_string(kHangSeconds) + " " + std::string(PLDVO_BINARY) +
       " run --dataset " + dataset.string() + " --out " + (TestRoot() / name).string() +
-      " --set odometry.parallel_mapping=false " + extra + " > " + log.string() + " 2>&1";
+      " --set odometry.parallel_mapping=false --set odometry.random_start_candidates=1 " + extra +
+      " > " + log.string() + " 2>&1";
   const int status = std::system(command.c_str());
   RunResult result;
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -226,6 +227,24 @@ TEST(FaultSuiteTest, WrongSizeFrameIsSkipped) {
   ASSERT_TRUE(cv::imwrite(image.string(), cv::Mat(120, 160, CV_8UC1, cv::Scalar(100))));
   ExpectFrameSkipped(RunPldvo(dataset, "run_wrong_size"), TestRoot() / "run_wrong_size", image,
                      "image is 160x120, the calibration expects 320x240");
+}
+
+// The choice among random starts runs the first frames before the run: a frame it cannot process
+// there is skipped by every candidate (counted against each alike) and by the run.
+TEST(FaultSuiteTest, RandomStartCandidatesSkipAWrongSizeFrame) {
+  const fs::path dataset = CopyOf(Sequence(kFrames), "wrong_size_random_start");
+  const fs::path image = Images(dataset).at(kFault);
+  ASSERT_TRUE(cv::imwrite(image.string(), cv::Mat(120, 160, CV_8UC1, cv::Scalar(100))));
+  const fs::path out = TestRoot() / "run_wrong_size_random_start";
+  const RunResult run =
+      RunPldvo(dataset, "run_wrong_size_random_start", "--set odometry.random_start_candidates=2");
+  ExpectFrameSkipped(run, out, image, "image is 160x120, the calibration expects 320x240");
+  const nlohmann::json summary = nlohmann::json::parse(Slurp(out / "summary.json"));
+  ASSERT_TRUE(summary["random_start"].is_object()) << run.log;
+  ASSERT_EQ(summary["random_start"]["candidates"].size(), 2u);
+  for (const nlohmann::json& candidate : summary["random_start"]["candidates"]) {
+    EXPECT_EQ(candidate["untracked"].get<int>(), 1) << candidate.dump();
+  }
 }
 
 TEST(FaultSuiteTest, AllBlackFrameIsLostAndTrackingResumes) {

@@ -65,7 +65,10 @@ int Pldvo(const std::string& args, const fs::path& log) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-const char* const kDeterministic = " --set odometry.parallel_mapping=false";
+// Inline mapping, and one initial map: the choice among several random starts
+// (RandomStartChoosesTheBestFittingInitialMap) would run these short sequences three more times.
+const char* const kDeterministic =
+    " --set odometry.parallel_mapping=false --set odometry.random_start_candidates=1";
 
 // Rows of a CSV file with a header line, each split at commas.
 std::vector<std::vector<std::string>> CsvRows(const fs::path& path) {
@@ -397,6 +400,71 @@ TEST(RunCommandTest, TwoViewBootstrapStartsTheRunOrFallsBack) {
                   bad_log),
             2);
   EXPECT_NE(Slurp(bad_log).find("two_view"), std::string::npos) << Slurp(bad_log);
+}
+
+// odometry.random_start_candidates: the run tries three random initial maps over the first
+// frames, scores each by the fit of its tracked frames, and starts from the best: the chosen
+// candidate's scores are the means that a plain run from its seed reports for the same frames,
+// and the run is that plain run, pose for pose.
+TEST(RunCommandTest, RandomStartChoosesTheBestFittingInitialMap) {
+  const std::string kFlags = kDeterministic + std::string(" --max_frames 16");
+  const fs::path chosen_run = TestRoot() / "run_random_start";
+  ASSERT_EQ(
+      Pldvo("run --dataset " + SequenceDir().string() + " --out " + chosen_run.string() + kFlags +
+                " --set odometry.random_start_candidates=3"
+                " --set odometry.random_start_frames=10",
+            TestRoot() / "run_random_start.log"),
+      0)
+      << Slurp(TestRoot() / "run_random_start.log");
+  const nlohmann::json summary = nlohmann::json::parse(Slurp(chosen_run / "summary.json"));
+  ASSERT_TRUE(summary["two_view_bootstrap"].is_null());  // the start this choice is for
+  const nlohmann::json& choice = summary["random_start"];
+  ASSERT_TRUE(choice.is_object()) << summary.dump();
+  std::printf("random start: %s\n", choice.dump().c_str());
+  EXPECT_EQ(choice["frames"].get<int>(), 10);
+  ASSERT_EQ(choice["candidates"].size(), 3u);
+  const nlohmann::json* best = nullptr;
+  for (size_t c = 0; c < 3; ++c) {
+    const nlohmann::json& candidate = choice["candidates"][c];
+    EXPECT_EQ(candidate["init_seed"].get<int>(), 1 + 1000 * static_cast<int>(c));
+    EXPECT_EQ(candidate["untracked"].get<int>(), 0);
+    EXPECT_GT(candidate["mean_correlation"].get<double>(), 0.0);
+    EXPECT_GT(candidate["mean_rms"].get<double>(), 0.0);
+    if (best == nullptr || candidate["mean_correlation"] > (*best)["mean_correlation"]) {
+      best = &candidate;
+    }
+  }
+  EXPECT_EQ(choice["init_seed"], (*best)["init_seed"]);
+
+  const int seed = choice["init_seed"].get<int>();
+  const fs::path plain = TestRoot() / "run_random_start_plain";
+  ASSERT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " + plain.string() + kFlags +
+                      " --set mapping.init_seed=" + std::to_string(seed),
+                  TestRoot() / "run_random_start_plain.log"),
+            0);
+  EXPECT_TRUE(nlohmann::json::parse(Slurp(plain / "summary.json"))["random_start"].is_null());
+  EXPECT_EQ(Slurp(plain / "trajectory.txt"), Slurp(chosen_run / "trajectory.txt"));
+  double rms_sum = 0.0, correlation_sum = 0.0;
+  int tracked = 0;
+  for (const std::vector<std::string>& row : CsvRows(plain / "timing.csv")) {
+    const int index = std::stoi(row[0]);
+    if (index < 1 || index >= 10) continue;
+    ASSERT_TRUE(row[2] == "tracked" || row[2] == "keyframe") << row[2];
+    rms_sum += std::stod(row[10]);
+    correlation_sum += std::stod(row[12]);
+    ++tracked;
+  }
+  ASSERT_EQ(tracked, 9);
+  EXPECT_NEAR((*best)["mean_rms"].get<double>(), rms_sum / tracked, 1e-5);
+  EXPECT_NEAR((*best)["mean_correlation"].get<double>(), correlation_sum / tracked, 1e-5);
+
+  const fs::path bad_log = TestRoot() / "run_random_start_bad.log";
+  EXPECT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " +
+                      (TestRoot() / "run_random_start_bad").string() +
+                      " --set odometry.random_start_candidates=0",
+                  bad_log),
+            2);
+  EXPECT_NE(Slurp(bad_log).find("random_start_candidates"), std::string::npos) << Slurp(bad_log);
 }
 
 TEST(RunCommandTest, UnknownConfigKeyIsAnError) {

@@ -1,0 +1,115 @@
+#include "backend/odometry/random_start_choice.h"
+
+#include <algorithm>
+#include <atomic>
+#include <exception>
+#include <mutex>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#include "backend/odometry/odometry.h"
+#include "core/wall_clock.h"
+
+namespace pldvo {
+
+RandomStartChoice ChooseRandomStart(const Dataset& dataset, const OdometryConfig& config,
+                                    int num_frames) {
+  const int candidates = config.odometry.random_start_candidates;
+  if (candidates < 2 || num_frames < 2) {
+    throw std::invalid_argument(
+        "ChooseRandomStart: needs random_start_candidates >= 2 and 2 frames");
+  }
+  const auto start = WallClock::now();
+  RandomStartChoice choice;
+  choice.frames = std::min(config.odometry.random_start_frames, num_frames);
+
+  // The frames once for every candidate; an empty optional is a frame that failed to load.
+  std::vector<std::optional<Frame>> frames(choice.frames);
+  std::vector<std::string> errors(choice.frames);
+  for (int i = 0; i < choice.frames; ++i) {
+    try {
+      frames[i] = dataset.Load(i);
+      if (frames[i]->image.empty()) errors[i] = "empty image " + frames[i]->path;
+    } catch (const std::exception& e) {
+      errors[i] = e.what();
+    }
+    if (!errors[i].empty()) frames[i].reset();
+  }
+
+  OdometryConfig base_config = config;
+  base_config.odometry.parallel_mapping = false;
+  base_config.odometry.compare_solver = OdometryOptions::CompareSolver::kNone;
+  base_config.backend.edge_ba.enabled = false;
+  base_config.backend.windowed_ba.enabled = false;
+  // Candidate c's score; candidates run side by side, one per core (each is deterministic).
+  auto score = [&](int c) {
+    RandomStartCandidate candidate;
+    candidate.init_seed = config.mapping.init_seed + 1000 * c;
+    OdometryConfig candidate_config = base_config;
+    candidate_config.mapping.init_seed = candidate.init_seed;
+    Odometry odometry(dataset.camera(), candidate_config);
+    double correlation_sum = 0.0, rms_sum = 0.0;
+    int tracked = 0;
+    for (int i = 0; i < choice.frames; ++i) {
+      // A frame that fails to load or to process is skipped, as in the run (sequence_runner.cc).
+      std::optional<OdometryFrameResult> processed;
+      if (frames[i]) {
+        try {
+          processed = odometry.ProcessFrame(i, frames[i]->timestamp, frames[i]->image);
+        } catch (const std::exception& e) {
+          processed = odometry.SkipFrame(i, frames[i]->timestamp, e.what());
+        }
+      }
+      const OdometryFrameResult result =
+          processed ? *processed : odometry.SkipFrame(i, dataset.timestamp(i), errors[i]);
+      if (i == 0) continue;  // the keyframe itself
+      if (IsTracked(result.status)) {
+        correlation_sum += result.tracking.intensity_correlation;
+        rms_sum += result.tracking.final_rms;
+        ++tracked;
+      } else {
+        ++candidate.untracked;
+      }
+    }
+    odometry.Finish();
+    if (tracked > 0) {
+      candidate.mean_correlation = correlation_sum / tracked;
+      candidate.mean_rms = rms_sum / tracked;
+    }
+    return candidate;
+  };
+  choice.candidates.resize(candidates);
+  std::atomic<int> next{0};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  auto work = [&] {
+    for (int c = next++; c < candidates; c = next++) {
+      try {
+        choice.candidates[c] = score(c);
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(failure_mutex);
+        if (!failure) failure = std::current_exception();
+      }
+    }
+  };
+  const int workers =
+      std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, candidates);
+  std::vector<std::thread> threads;
+  for (int w = 1; w < workers; ++w) threads.emplace_back(work);
+  work();
+  for (std::thread& thread : threads) thread.join();
+  if (failure) std::rethrow_exception(failure);
+  const auto best = std::min_element(
+      choice.candidates.begin(), choice.candidates.end(),
+      [](const RandomStartCandidate& a, const RandomStartCandidate& b) {
+        return a.untracked < b.untracked ||
+               (a.untracked == b.untracked && a.mean_correlation > b.mean_correlation);
+      });
+  choice.init_seed = best->init_seed;
+  choice.ms = MsSince(start);
+  return choice;
+}
+
+}  // namespace pldvo
