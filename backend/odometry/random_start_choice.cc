@@ -1,13 +1,11 @@
 #include "backend/odometry/random_start_choice.h"
 
 #include <algorithm>
-#include <atomic>
-#include <exception>
-#include <mutex>
+#include <future>
 #include <optional>
 #include <stdexcept>
 #include <string>
-#include <thread>
+#include <vector>
 
 #include "backend/odometry/odometry.h"
 #include "core/wall_clock.h"
@@ -43,7 +41,7 @@ RandomStartChoice ChooseRandomStart(const Dataset& dataset, const OdometryConfig
   base_config.odometry.compare_solver = OdometryOptions::CompareSolver::kNone;
   base_config.backend.edge_ba.enabled = false;
   base_config.backend.windowed_ba.enabled = false;
-  // Candidate c's score; candidates run side by side, one per core (each is deterministic).
+  // Candidate c's score (deterministic: the inline mapping).
   auto score = [&](int c) {
     RandomStartCandidate candidate;
     candidate.init_seed = config.mapping.init_seed + 1000 * c;
@@ -54,16 +52,16 @@ RandomStartChoice ChooseRandomStart(const Dataset& dataset, const OdometryConfig
     int tracked = 0;
     for (int i = 0; i < choice.frames; ++i) {
       // A frame that fails to load or to process is skipped, as in the run (sequence_runner.cc).
-      std::optional<OdometryFrameResult> processed;
-      if (frames[i]) {
+      OdometryFrameResult result;
+      if (!frames[i]) {
+        result = odometry.SkipFrame(i, dataset.timestamp(i), errors[i]);
+      } else {
         try {
-          processed = odometry.ProcessFrame(i, frames[i]->timestamp, frames[i]->image);
+          result = odometry.ProcessFrame(i, frames[i]->timestamp, frames[i]->image);
         } catch (const std::exception& e) {
-          processed = odometry.SkipFrame(i, frames[i]->timestamp, e.what());
+          result = odometry.SkipFrame(i, frames[i]->timestamp, e.what());
         }
       }
-      const OdometryFrameResult result =
-          processed ? *processed : odometry.SkipFrame(i, dataset.timestamp(i), errors[i]);
       if (i == 0) continue;  // the keyframe itself
       if (IsTracked(result.status)) {
         correlation_sum += result.tracking.intensity_correlation;
@@ -80,27 +78,12 @@ RandomStartChoice ChooseRandomStart(const Dataset& dataset, const OdometryConfig
     }
     return candidate;
   };
-  choice.candidates.resize(candidates);
-  std::atomic<int> next{0};
-  std::exception_ptr failure;
-  std::mutex failure_mutex;
-  auto work = [&] {
-    for (int c = next++; c < candidates; c = next++) {
-      try {
-        choice.candidates[c] = score(c);
-      } catch (...) {
-        const std::lock_guard<std::mutex> lock(failure_mutex);
-        if (!failure) failure = std::current_exception();
-      }
-    }
-  };
-  const int workers =
-      std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, candidates);
-  std::vector<std::thread> threads;
-  for (int w = 1; w < workers; ++w) threads.emplace_back(work);
-  work();
-  for (std::thread& thread : threads) thread.join();
-  if (failure) std::rethrow_exception(failure);
+  // Each candidate on its own thread; get() passes on what a candidate threw.
+  std::vector<std::future<RandomStartCandidate>> scored;
+  for (int c = 0; c < candidates; ++c) scored.push_back(std::async(std::launch::async, score, c));
+  for (std::future<RandomStartCandidate>& candidate : scored) {
+    choice.candidates.push_back(candidate.get());
+  }
   const auto best = std::min_element(
       choice.candidates.begin(), choice.candidates.end(),
       [](const RandomStartCandidate& a, const RandomStartCandidate& b) {

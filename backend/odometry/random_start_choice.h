@@ -41,8 +41,8 @@ struct RandomStartChoice {
 // Candidate c (0 .. random_start_candidates - 1) starts from mapping.init_seed + 1000 c; each
 // runs `config` over the first min(random_start_frames, num_frames) frames of `dataset` with the
 // mapping inline (the run's results with its mapping thread, odometry.mapping_lag), without edge
-// or windowed BA and the solver comparison, side by side on up to one thread per core (the
-// scores do not depend on it). The images are loaded once; a frame that cannot be loaded is
+// or windowed BA and the solver comparison, each on its own thread (the scores do not depend on
+// it). The images are loaded once; a frame that cannot be loaded is
 // skipped as in the run. Ties go to the lower candidate. Throws std::invalid_argument when
 // random_start_candidates < 2 or num_frames < 2.
 RandomStartChoice ChooseRandomStart(const Dataset& dataset, const OdometryConfig& config,
