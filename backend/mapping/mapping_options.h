@@ -142,10 +142,10 @@ struct MappingOptions {
   // dropped (SVO: 0.1).
   double min_inlier_ratio = 0.1;
   int blacklist_threshold = 5;  // a pixel whose stereo failed this often is no longer searched
-  // Stripes the per-pixel passes (stereo search and fusion, smoothing) are split into, run on
-  // OpenCV's thread pool (cv::parallel_for_); every pixel's result is its own, so the map does
-  // not depend on it. 0: as many as the pool has threads (cv::getNumThreads); 1: the calling
-  // thread alone.
+  // Stripes the per-pixel passes (stereo search and fusion, removal, filling, smoothing) are split
+  // into, run on OpenCV's thread pool (cv::parallel_for_); every pixel's result is its own, so the
+  // map does not depend on it. 0: as many as the pool has threads (cv::getNumThreads); 1: the
+  // calling thread alone.
   int num_threads = 0;
 
   // ---- Regularisation (Engel 2013 Sec. 2.3).
@@ -284,8 +284,9 @@ struct MappingOptions {
     v.Field("blacklist_threshold", &blacklist_threshold,
             "Stereo failures after which a pixel is no longer searched (5).");
     v.Field("num_threads", &num_threads,
-            "Stripes of the stereo and smoothing passes on OpenCV's thread pool; the map does not "
-            "depend on it (0 = cv::getNumThreads(), default; 1 = the mapping thread alone).");
+            "Stripes of the stereo, removal, filling and smoothing passes on OpenCV's thread pool; "
+            "the map does not depend on it (0 = cv::getNumThreads(), default; 1 = the mapping "
+            "thread alone).");
     v.Field("regularize", &regularize, "Smooth the map among compatible neighbours.");
     v.Field("regularization_radius", &regularization_radius, "Smoothing window radius (2).");
     v.Field("regularization_gate_sigmas", &regularization_gate_sigmas,

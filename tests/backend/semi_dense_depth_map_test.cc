@@ -808,6 +808,31 @@ TEST(DepthRegularizerTest, MatchesTheReferenceBitForBit) {
   }
 }
 
+TEST(DepthRegularizerTest, RemovalAndFillingDoNotDependOnTheStripes) {
+  // A sparse map whose every pixel is a candidate: isolated hypotheses to remove and holes
+  // among valid neighbours to fill. One stripe of rows is the sequential pass; two and three
+  // (mapping.num_threads) must give the same map and counts.
+  for (const uint32_t seed : {3u, 4u}) {
+    SemiDenseDepthMap map = RandomSparseMap(41, 29, seed);
+    for (int i = 0; i < map.num_pixels(); ++i) map.SetCandidate(i, true, -1);
+    MappingOptions options;
+    options.num_threads = 1;
+    SemiDenseDepthMap expected = map;
+    const int expected_removed = RemoveIsolatedHypotheses(options, &expected);
+    const int expected_filled = FillHoles(options, &expected);
+    EXPECT_GT(expected_removed, 10) << seed;
+    EXPECT_GT(expected_filled, 100) << seed;
+    for (const int threads : {2, 3}) {
+      SCOPED_TRACE(testing::Message() << "seed " << seed << " threads " << threads);
+      options.num_threads = threads;
+      SemiDenseDepthMap actual = map;
+      EXPECT_EQ(RemoveIsolatedHypotheses(options, &actual), expected_removed);
+      EXPECT_EQ(FillHoles(options, &actual), expected_filled);
+      ExpectIdenticalMaps(actual, expected);
+    }
+  }
+}
+
 TEST(DepthMapIoTest, WritesPngAndPly) {
   const PinholeCamera camera = TestCamera();
   SemiDenseDepthMap map(camera.width, camera.height);
