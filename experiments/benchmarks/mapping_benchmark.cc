@@ -6,6 +6,8 @@
 //   Mapping/regularized/...  RegularizedMap: smoothing (smooth:1) and 3D line regularisation
 //                            (lines:1), what every job publishes
 //   Mapping/reference        BuildReferencePoints of the published map (4000 points per level)
+//   Mapping/propagate        PropagateDepthMap of the published map to frame 16 as a new
+//                            keyframe (its ground-truth pose), what a keyframe switch runs
 // and the regularisation steps (backend/mapping/depth_regularizer.h) on a generated 640x480
 // semi-dense map (MakeEdgeMap: ~12% valid pixels in 3-px bands along random segments, variances
 // log-uniform over four orders of magnitude, depth discontinuities where segments cross):
@@ -21,6 +23,7 @@
 #include <vector>
 
 #include "backend/mapping/depth_mapper.h"
+#include "backend/mapping/depth_propagation.h"
 #include "backend/mapping/depth_regularizer.h"
 #include "backend/odometry/reference_builder.h"
 #include "experiments/evaluation/mapping_ground_truth.h"
@@ -127,6 +130,19 @@ void BM_Reference(benchmark::State& state) {
   state.counters["points_level0"] = reference.levels[0].points.size();
 }
 
+void BM_Propagate(benchmark::State& state) {
+  const Fixture& fixture = GetFixture();
+  const ImagePyramid new_keyframe(fixture.next_image, 1);
+  PropagationStats stats;
+  for (auto _ : state) {
+    SemiDenseDepthMap map =
+        PropagateDepthMap(fixture.published, fixture.mapper.keyframe(), new_keyframe, cv::Mat(),
+                          fixture.camera, fixture.next_from_ref, fixture.options, &stats);
+    benchmark::DoNotOptimize(map);
+  }
+  state.counters["propagated"] = stats.propagated;
+}
+
 // The generated map of the regularisation benchmarks: 65 random segments of 40-300 px drawn
 // 3 px wide (a later segment overwrites an earlier one where they cross); each band pixel at
 // least 4 px from the border is a candidate, 90% of them valid with a per-segment plane of
@@ -223,6 +239,7 @@ BENCHMARK(BM_Regularized)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_Reference)->Name("Mapping/reference")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Propagate)->Name("Mapping/propagate")->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Smooth)->Name("Mapping/smooth")->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_InPlaceStep<RemoveIsolatedHypotheses>)
     ->Name("Mapping/remove_isolated")
