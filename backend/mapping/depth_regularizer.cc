@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <utility>
 #include <vector>
 
 #include "backend/mapping/pixel_stripes.h"
@@ -94,86 +95,67 @@ int SmoothDepthMap(const SemiDenseDepthMap& in, const MappingOptions& options,
 int RemoveIsolatedHypotheses(const MappingOptions& options, SemiDenseDepthMap* map) {
   const int r = options.regularization_radius;
   const double gate_sq = options.regularization_gate_sigmas * options.regularization_gate_sigmas;
-  // Stripes of rows find the isolated hypotheses in the unchanged map; they are removed after, in
-  // raster order.
+  // Found in stripes of rows of the unchanged map, removed after.
   const SemiDenseDepthMap& in = *map;
-  const int stripes = NumStripes(options);
-  std::vector<std::vector<int>> removed(stripes);
-  ForEachStripe(stripes, [&](int stripe) {
-    const int y_end = in.height() * (stripe + 1) / stripes;
-    for (int y = in.height() * stripe / stripes; y < y_end; ++y) {
-      for (int x = 0; x < in.width(); ++x) {
-        const int i = in.Index(x, y);
-        if (!in.valid(i)) continue;
-        const double d_i = in.idepth(i), v_i = in.idepth_var(i);
-        int neighbours = 0;
-        for (int dy = -r; dy <= r && neighbours < options.min_neighbors_keep; ++dy) {
-          const int yy = y + dy;
-          if (yy < 0 || yy >= in.height()) continue;
-          for (int dx = -r; dx <= r; ++dx) {
-            const int xx = x + dx;
-            if ((dx == 0 && dy == 0) || xx < 0 || xx >= in.width()) continue;
-            const int j = in.Index(xx, yy);
-            if (!in.valid(j)) continue;
-            const double d_j = in.idepth(j);
-            if ((d_i - d_j) * (d_i - d_j) <= gate_sq * (v_i + in.idepth_var(j))) ++neighbours;
+  const std::vector<int> removed = CollectRowsInStripes<int>(
+      in.height(), NumStripes(options), [&](int y, std::vector<int>* found) {
+        for (int x = 0; x < in.width(); ++x) {
+          const int i = in.Index(x, y);
+          if (!in.valid(i)) continue;
+          const double d_i = in.idepth(i), v_i = in.idepth_var(i);
+          int neighbours = 0;
+          for (int dy = -r; dy <= r && neighbours < options.min_neighbors_keep; ++dy) {
+            const int yy = y + dy;
+            if (yy < 0 || yy >= in.height()) continue;
+            for (int dx = -r; dx <= r; ++dx) {
+              const int xx = x + dx;
+              if ((dx == 0 && dy == 0) || xx < 0 || xx >= in.width()) continue;
+              const int j = in.Index(xx, yy);
+              if (!in.valid(j)) continue;
+              const double d_j = in.idepth(j);
+              if ((d_i - d_j) * (d_i - d_j) <= gate_sq * (v_i + in.idepth_var(j))) ++neighbours;
+            }
           }
+          if (neighbours < options.min_neighbors_keep) found->push_back(i);
         }
-        if (neighbours < options.min_neighbors_keep) removed[stripe].push_back(i);
-      }
-    }
-  });
-  int count = 0;
-  for (const std::vector<int>& indices : removed) {
-    for (int i : indices) map->Invalidate(i);
-    count += static_cast<int>(indices.size());
-  }
-  return count;
+      });
+  for (int i : removed) map->Invalidate(i);
+  return static_cast<int>(removed.size());
 }
 
 int FillHoles(const MappingOptions& options, SemiDenseDepthMap* map) {
   const int r = options.regularization_radius;
-  // Stripes of rows compute the fills from the unchanged map; they are applied after, in raster
-  // order.
+  // Computed in stripes of rows of the unchanged map, filled after.
   const SemiDenseDepthMap& in = *map;
-  const int stripes = NumStripes(options);
-  std::vector<std::vector<std::pair<int, double>>> filled(stripes);
-  ForEachStripe(stripes, [&](int stripe) {
-    const int y_end = in.height() * (stripe + 1) / stripes;
-    for (int y = in.height() * stripe / stripes; y < y_end; ++y) {
-      for (int x = 0; x < in.width(); ++x) {
-        const int i = in.Index(x, y);
-        if (in.valid(i) || !in.candidate(i) || in.blacklist(i) >= options.blacklist_threshold) {
-          continue;
-        }
-        double sum = 0.0, sum_info = 0.0;
-        int neighbours = 0;
-        for (int dy = -r; dy <= r; ++dy) {
-          const int yy = y + dy;
-          if (yy < 0 || yy >= in.height()) continue;
-          for (int dx = -r; dx <= r; ++dx) {
-            const int xx = x + dx;
-            if (xx < 0 || xx >= in.width()) continue;
-            const int j = in.Index(xx, yy);
-            if (!in.valid(j)) continue;
-            sum += in.idepth(j) / in.idepth_var(j);
-            sum_info += 1.0 / in.idepth_var(j);
-            ++neighbours;
+  const std::vector<std::pair<int, double>> filled = CollectRowsInStripes<std::pair<int, double>>(
+      in.height(), NumStripes(options), [&](int y, std::vector<std::pair<int, double>>* found) {
+        for (int x = 0; x < in.width(); ++x) {
+          const int i = in.Index(x, y);
+          if (in.valid(i) || !in.candidate(i) || in.blacklist(i) >= options.blacklist_threshold) {
+            continue;
           }
+          double sum = 0.0, sum_info = 0.0;
+          int neighbours = 0;
+          for (int dy = -r; dy <= r; ++dy) {
+            const int yy = y + dy;
+            if (yy < 0 || yy >= in.height()) continue;
+            for (int dx = -r; dx <= r; ++dx) {
+              const int xx = x + dx;
+              if (xx < 0 || xx >= in.width()) continue;
+              const int j = in.Index(xx, yy);
+              if (!in.valid(j)) continue;
+              sum += in.idepth(j) / in.idepth_var(j);
+              sum_info += 1.0 / in.idepth_var(j);
+              ++neighbours;
+            }
+          }
+          if (neighbours >= options.min_neighbors_fill) found->emplace_back(i, sum / sum_info);
         }
-        if (neighbours >= options.min_neighbors_fill)
-          filled[stripe].emplace_back(i, sum / sum_info);
-      }
-    }
-  });
-  int count = 0;
-  for (const auto& fills : filled) {
-    for (const auto& [i, idepth] : fills) {
-      map->Set(i, idepth, options.init_idepth_var, options.validity_initial);
-    }
-    count += static_cast<int>(fills.size());
+      });
+  for (const auto& [i, idepth] : filled) {
+    map->Set(i, idepth, options.init_idepth_var, options.validity_initial);
   }
-  return count;
+  return static_cast<int>(filled.size());
 }
 
 }  // namespace pldvo

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <opencv2/core/utility.hpp>
+#include <utility>
+#include <vector>
 
 #include "backend/mapping/mapping_options.h"
 
@@ -27,6 +29,23 @@ void ForEachStripe(int stripes, const Body& body) {
   } else {
     cv::parallel_for_(cv::Range(0, stripes), run, stripes);
   }
+}
+
+// Calls row(y, &found) for the rows [0, height) in stripes of rows and returns what they appended
+// to `found`, in raster order, whatever the stripe count: a pass that reads a map in stripes and
+// changes it afterwards.
+template <typename T, typename Row>
+std::vector<T> CollectRowsInStripes(int height, int stripes, const Row& row) {
+  std::vector<std::vector<T>> found(stripes);
+  ForEachStripe(stripes, [&](int stripe) {
+    const int y_end = height * (stripe + 1) / stripes;
+    for (int y = height * stripe / stripes; y < y_end; ++y) row(y, &found[stripe]);
+  });
+  std::vector<T> all = std::move(found[0]);
+  for (int stripe = 1; stripe < stripes; ++stripe) {
+    all.insert(all.end(), found[stripe].begin(), found[stripe].end());
+  }
+  return all;
 }
 
 }  // namespace pldvo

@@ -2,11 +2,10 @@
 
 #include <algorithm>
 #include <future>
-#include <optional>
 #include <stdexcept>
-#include <string>
 #include <vector>
 
+#include "backend/odometry/loaded_frame.h"
 #include "backend/odometry/odometry.h"
 #include "core/wall_clock.h"
 
@@ -23,18 +22,9 @@ RandomStartChoice ChooseRandomStart(const Dataset& dataset, const OdometryConfig
   RandomStartChoice choice;
   choice.frames = std::min(config.odometry.random_start_frames, num_frames);
 
-  // The frames once for every candidate; an empty optional is a frame that failed to load.
-  std::vector<std::optional<Frame>> frames(choice.frames);
-  std::vector<std::string> errors(choice.frames);
-  for (int i = 0; i < choice.frames; ++i) {
-    try {
-      frames[i] = dataset.Load(i);
-      if (frames[i]->image.empty()) errors[i] = "empty image " + frames[i]->path;
-    } catch (const std::exception& e) {
-      errors[i] = e.what();
-    }
-    if (!errors[i].empty()) frames[i].reset();
-  }
+  // The frames once for every candidate.
+  std::vector<LoadedFrame> frames;
+  for (int i = 0; i < choice.frames; ++i) frames.push_back(LoadFrame(dataset, i));
 
   OdometryConfig base_config = config;
   base_config.odometry.parallel_mapping = false;
@@ -52,14 +42,15 @@ RandomStartChoice ChooseRandomStart(const Dataset& dataset, const OdometryConfig
     int tracked = 0;
     for (int i = 0; i < choice.frames; ++i) {
       // A frame that fails to load or to process is skipped, as in the run (sequence_runner.cc).
+      const LoadedFrame& loaded = frames[i];
       OdometryFrameResult result;
-      if (!frames[i]) {
-        result = odometry.SkipFrame(i, dataset.timestamp(i), errors[i]);
+      if (!loaded.error.empty()) {
+        result = odometry.SkipFrame(i, dataset.timestamp(i), loaded.error);
       } else {
         try {
-          result = odometry.ProcessFrame(i, frames[i]->timestamp, frames[i]->image);
+          result = odometry.ProcessFrame(i, loaded.frame.timestamp, loaded.frame.image);
         } catch (const std::exception& e) {
-          result = odometry.SkipFrame(i, frames[i]->timestamp, e.what());
+          result = odometry.SkipFrame(i, loaded.frame.timestamp, e.what());
         }
       }
       if (i == 0) continue;  // the keyframe itself

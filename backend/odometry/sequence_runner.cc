@@ -25,6 +25,7 @@
 #include "backend/odometry/bootstrap_refiner.h"
 #include "backend/odometry/frame_preparer.h"
 #include "backend/odometry/live_frame_source.h"
+#include "backend/odometry/loaded_frame.h"
 #include "backend/odometry/odometry.h"
 #include "backend/odometry/random_start_choice.h"
 #include "backend/odometry/solver_comparison.h"
@@ -225,39 +226,6 @@ InitialMap PrepareInitialMap(const Dataset& dataset, const OdometryConfig& confi
     }
   }
   return initial;
-}
-
-struct LoadedFrame {
-  Frame frame;
-  std::string error;  // non-empty when loading failed
-  double load_ms = 0.0;
-  // odometry.frontend_thread: the frame's per-image work, done on the loading thread.
-  std::optional<PreparedFrame> prepared;
-};
-
-// Loads frame `index` and, with a `preparer`, prepares it on the same (loading) thread. A frame
-// that is not a gray image of the camera's size is left unprepared: ProcessFrame reports it.
-LoadedFrame LoadFrame(const Dataset& dataset, int index, FramePreparer* preparer) {
-  LoadedFrame loaded;
-  const auto start = WallClock::now();
-  try {
-    loaded.frame = dataset.Load(index);
-    if (loaded.frame.image.empty()) loaded.error = "empty image " + loaded.frame.path;
-  } catch (const std::exception& e) {
-    loaded.error = e.what();
-  }
-  loaded.load_ms = MsSince(start);
-  const cv::Mat& image = loaded.frame.image;
-  const PinholeCamera& camera = dataset.camera();
-  if (preparer != nullptr && loaded.error.empty() && image.channels() == 1 &&
-      image.cols == camera.width && image.rows == camera.height) {
-    try {
-      loaded.prepared = preparer->Prepare(image);
-    } catch (const std::exception&) {
-      // Left unprepared: ProcessFrame(image) repeats the work and reports the failure.
-    }
-  }
-  return loaded;
 }
 
 // The offline feed: every frame in order, frame i + 1 loaded (and prepared) on another thread

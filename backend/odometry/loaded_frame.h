@@ -1,0 +1,28 @@
+// A dataset frame as loaded for the odometry: the frame or why it could not be loaded, and with a
+// FramePreparer its per-image work done on the loading thread (odometry.frontend_thread).
+#ifndef PLDVO_BACKEND_ODOMETRY_LOADED_FRAME_H_
+#define PLDVO_BACKEND_ODOMETRY_LOADED_FRAME_H_
+
+#include <optional>
+#include <string>
+
+#include "backend/odometry/frame_preparer.h"
+#include "core/dataset.h"
+
+namespace pldvo {
+
+struct LoadedFrame {
+  Frame frame;
+  std::string error;  // non-empty when loading failed
+  double load_ms = 0.0;
+  // odometry.frontend_thread: the frame's per-image work, done on the loading thread.
+  std::optional<PreparedFrame> prepared;
+};
+
+// Loads frame `index` and, with a `preparer`, prepares it on the same (loading) thread. A frame
+// that is not a gray image of the camera's size is left unprepared: ProcessFrame reports it.
+LoadedFrame LoadFrame(const Dataset& dataset, int index, FramePreparer* preparer = nullptr);
+
+}  // namespace pldvo
+
+#endif  // PLDVO_BACKEND_ODOMETRY_LOADED_FRAME_H_
