@@ -407,13 +407,19 @@ SemiDenseDepthMap DepthMapper::RegularizedMap(bool smooth, bool line_regularize,
 PropagationStats DepthMapper::PropagateToNewKeyframe(const cv::Mat& image, const EdgeTrace& edges,
                                                      const SE3& new_from_old,
                                                      const AffineBrightness& brightness) {
-  const SemiDenseDepthMap old_map =
-      RegularizedMap(options_.regularize, options_.line_regularization);
+  return PropagateToNewKeyframe(RegularizedMap(options_.regularize, options_.line_regularization),
+                                image, edges, new_from_old, brightness);
+}
+
+PropagationStats DepthMapper::PropagateToNewKeyframe(const SemiDenseDepthMap& old_regularized,
+                                                     const cv::Mat& image, const EdgeTrace& edges,
+                                                     const SE3& new_from_old,
+                                                     const AffineBrightness& brightness) {
   const ImagePyramid old_keyframe = keyframe_;
   SetKeyframe(image, edges);
   PropagationStats stats;
-  map_ = PropagateDepthMap(old_map, old_keyframe, keyframe_, edges_.id_map, camera_, new_from_old,
-                           options_, &stats, brightness);
+  map_ = PropagateDepthMap(old_regularized, old_keyframe, keyframe_, edges_.id_map, camera_,
+                           new_from_old, options_, &stats, brightness);
   return stats;
 }
 

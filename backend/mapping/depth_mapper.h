@@ -149,6 +149,12 @@ class DepthMapper {
   PropagationStats PropagateToNewKeyframe(const cv::Mat& image, const EdgeTrace& edges,
                                           const SE3& new_from_old,
                                           const AffineBrightness& brightness = {});
+  // The same from `old_regularized`, which must be this state's RegularizedMap(options.regularize,
+  // options.line_regularization) (the mapping worker's last published map): not computed again.
+  PropagationStats PropagateToNewKeyframe(const SemiDenseDepthMap& old_regularized,
+                                          const cv::Mat& image, const EdgeTrace& edges,
+                                          const SE3& new_from_old,
+                                          const AffineBrightness& brightness = {});
 
   const SemiDenseDepthMap& depth_map() const { return map_; }
   const ImagePyramid& keyframe() const { return keyframe_; }

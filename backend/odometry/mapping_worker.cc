@@ -196,6 +196,9 @@ void MappingWorker::InitializeRandomMap(const MappingJob& job, KeyframeMap* publ
 
 void MappingWorker::Run(const MappingJob& job) {
   const auto start = WallClock::now();
+  // The regularised map of the state this job starts from, when known; a job that changes the
+  // state leaves it unknown until it publishes.
+  std::shared_ptr<const SemiDenseDepthMap> state_map = std::move(state_map_);
   try {
     auto published = std::make_shared<KeyframeMap>();
     switch (job.kind) {
@@ -212,7 +215,10 @@ void MappingWorker::Run(const MappingJob& job) {
         num_updates_ = 0;
         break;
       case MappingJob::Kind::kUpdate:
-        if (job.keyframe_id != keyframe_id_) return;  // for a keyframe no longer current
+        if (job.keyframe_id != keyframe_id_) {  // for a keyframe no longer current
+          state_map_ = std::move(state_map);
+          return;
+        }
         mapper_.UpdateWithFrame(InReferenceBrightness(job.image, job.brightness), job.cur_from_kf,
                                 job.lines_in_cur, job.pose_covariance, job.line_cov_scale);
         ++num_updates_;
@@ -220,7 +226,10 @@ void MappingWorker::Run(const MappingJob& job) {
         break;
       case MappingJob::Kind::kLineDepths:
       case MappingJob::Kind::kIdepthCorrections: {
-        if (job.keyframe_id != keyframe_id_) return;  // for a keyframe no longer current
+        if (job.keyframe_id != keyframe_id_) {  // for a keyframe no longer current
+          state_map_ = std::move(state_map);
+          return;
+        }
         int fused = 0, outliers = 0, corrected = 0;
         if (job.kind == MappingJob::Kind::kLineDepths) {
           const LineDepthFusionStats stats = mapper_.FuseLineDepths(job.line_depths);
@@ -245,13 +254,18 @@ void MappingWorker::Run(const MappingJob& job) {
         break;
       }
       case MappingJob::Kind::kNewKeyframe: {
-        if (job.keep_retired_map) {
-          published->retired_map = std::make_shared<const SemiDenseDepthMap>(
+        // The retired keyframe's final map is the one the last job published: propagated (and
+        // kept) without smoothing and regularising the same state again.
+        if (state_map == nullptr) {
+          state_map = std::make_shared<const SemiDenseDepthMap>(
               mapper_.RegularizedMap(options_.regularize, options_.line_regularization));
+        }
+        if (job.keep_retired_map) {
+          published->retired_map = state_map;
           published->retired_keyframe_id = keyframe_id_;
         }
-        published->propagation =
-            mapper_.PropagateToNewKeyframe(job.image, job.edges, job.new_from_old, job.brightness);
+        published->propagation = mapper_.PropagateToNewKeyframe(*state_map, job.image, job.edges,
+                                                                job.new_from_old, job.brightness);
         if (mapper_.depth_map().CountValid() < job.min_propagated_points) {
           InitializeRandomMap(job, published.get());
         }
@@ -266,6 +280,7 @@ void MappingWorker::Run(const MappingJob& job) {
     published->updates_since_random_init = updates_since_random_init_;
     published->map = std::make_shared<const SemiDenseDepthMap>(
         mapper_.RegularizedMap(options_.regularize, options_.line_regularization));
+    state_map_ = published->map;
     Publish(std::move(published));
   } catch (const std::exception& e) {
     LOG(WARNING) << "mapping job for frame " << job.frame_index << " failed: " << e.what();

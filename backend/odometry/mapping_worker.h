@@ -155,7 +155,10 @@ class MappingWorker {
   int lag_;
   std::deque<MappingJob> held_back_;  // inline: updates waiting for lag_ later ones
   DepthMapper mapper_;                // touched only by the job runner
-  ImagePyramid keyframe_levels_;      // the keyframe's pyramid for the reference intensities
+  // RegularizedMap of mapper_'s state when the last job published it (null when a job changed the
+  // state since): the next keyframe switch propagates it. Touched only by the job runner.
+  std::shared_ptr<const SemiDenseDepthMap> state_map_;
+  ImagePyramid keyframe_levels_;  // the keyframe's pyramid for the reference intensities
   int keyframe_id_ = -1;
   int num_updates_ = 0;
   int updates_since_random_init_ = -1;  // KeyframeMap::updates_since_random_init

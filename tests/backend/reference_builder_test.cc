@@ -289,6 +289,47 @@ TEST(MappingWorkerTest, TrackingGetsTheLaggedMapOnEitherThread) {
   }
 }
 
+TEST(MappingWorkerTest, KeyframeSwitchPropagatesThePublishedMap) {
+  // The switch propagates (and keeps as the retired map) the map the last update published
+  // instead of regularising the same state again: the retired map is that very map, and the new
+  // keyframe's map is the one of a DepthMapper fed the same frames directly.
+  MappingOptions options;
+  ASSERT_TRUE(options.regularize);
+  MappingWorker worker(Camera(), options, /*parallel=*/false, /*max_pending_updates=*/2);
+  const cv::Mat image = Texture();
+  DepthMapper direct(Camera(), options);
+  worker.Submit(KeyframeJob(MappingJob::Kind::kInitialize, 0, 0, image));
+  direct.InitializeKeyframe(image, EdgeTrace());
+  for (int i = 1; i <= 3; ++i) {
+    const MappingJob update = UpdateJob(0, i, image);
+    worker.Submit(update);
+    direct.UpdateWithFrame(image, update.cur_from_kf, {});
+  }
+  const std::shared_ptr<const KeyframeMap> before = worker.Latest();
+  MappingJob next = KeyframeJob(MappingJob::Kind::kNewKeyframe, 1, 4, image);
+  next.new_from_old = SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(-0.03, 0.0, 0.0));
+  next.keep_retired_map = true;
+  worker.Submit(next);
+  direct.PropagateToNewKeyframe(image, EdgeTrace(), next.new_from_old);
+  const std::shared_ptr<const KeyframeMap> after = worker.Latest();
+  ASSERT_EQ(after->keyframe_id, 1);
+  EXPECT_EQ(after->retired_map, before->map);
+  EXPECT_FALSE(after->random_init);
+  const SemiDenseDepthMap expected =
+      direct.RegularizedMap(options.regularize, options.line_regularization);
+  const SemiDenseDepthMap& got = *after->map;
+  int valid = 0, differ = 0;
+  for (int i = 0; i < expected.num_pixels(); ++i) {
+    valid += expected.valid(i);
+    differ += expected.valid(i) != got.valid(i) ||
+              (expected.valid(i) && (expected.idepth(i) != got.idepth(i) ||
+                                     expected.idepth_var(i) != got.idepth_var(i)));
+  }
+  EXPECT_GT(valid, 100);
+  EXPECT_EQ(differ, 0);
+  EXPECT_EQ(worker.failed_jobs(), 0);
+}
+
 TEST(MappingWorkerTest, CountsTheUpdatesSinceTheLastRandomInitialisation) {
   // KeyframeMap::updates_since_random_init (odometry.random_map_warmup_updates): 0 on a random
   // map, +1 per fused update, carried across a switch that propagates the map, 0 again when the
