@@ -211,9 +211,12 @@ struct OdometryOptions {
   // start from the random map (no two-view start): the first random_start_frames frames run from
   // random_start_candidates initial maps (mapping.init_seed, + 1000 per further candidate) and
   // the run starts from the one whose frames fit best (fewest not tracked, then the highest mean
-  // intensity correlation). 1 = the one map of mapping.init_seed (paper.yaml).
+  // intensity correlation). 1 = the one map of mapping.init_seed (paper.yaml). With
+  // random_start_corner_check, where the two-view start failed only at its direction gate, the
+  // lowest epipolar error of its tracked corners decides instead of the correlation.
   int random_start_candidates = 3;
   int random_start_frames = 60;
+  bool random_start_corner_check = true;
   // Solver comparison (docs/tracking.md): every tracked frame's final tracking problem (the same
   // reference, lines and initial pose) is solved a second time with this solver; its poses, RPE
   // and time are reported beside the run's (summary.json `compare_solver`,
@@ -331,6 +334,10 @@ struct OdometryOptions {
         "random_start_frames frames; the run starts from the best fitting (1 = off; default 3).");
     v.Field("random_start_frames", &random_start_frames,
             "Frames each random-start candidate runs before the choice (default 60).");
+    v.Field("random_start_corner_check", &random_start_corner_check,
+            "Random-start choice: where the two-view start failed only at its direction gate, the "
+            "candidate whose poses fit its tracked corners best (epipolar error) wins instead of "
+            "the best intensity correlation (default true).");
     v.Choice("compare_solver", &compare_solver,
              ChoiceNames<CompareSolver>{{"none", CompareSolver::kNone},
                                         {"ceres", CompareSolver::kCeres},

@@ -1,7 +1,9 @@
 #include "backend/odometry/random_start_choice.h"
 
 #include <algorithm>
+#include <cmath>
 #include <future>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -12,7 +14,7 @@
 namespace pldvo {
 
 RandomStartChoice ChooseRandomStart(const Dataset& dataset, const OdometryConfig& config,
-                                    int num_frames) {
+                                    int num_frames, const CornerTracks* corners) {
   const int candidates = config.odometry.random_start_candidates;
   if (candidates < 2 || num_frames < 2) {
     throw std::invalid_argument(
@@ -40,6 +42,7 @@ RandomStartChoice ChooseRandomStart(const Dataset& dataset, const OdometryConfig
     Odometry odometry(dataset.camera(), candidate_config);
     double correlation_sum = 0.0, rms_sum = 0.0;
     int tracked = 0;
+    std::vector<SE3> world_from_cam;
     for (int i = 0; i < choice.frames; ++i) {
       // A frame that fails to load or to process is skipped, as in the run (sequence_runner.cc).
       const LoadedFrame& loaded = frames[i];
@@ -53,6 +56,7 @@ RandomStartChoice ChooseRandomStart(const Dataset& dataset, const OdometryConfig
           result = odometry.SkipFrame(i, loaded.frame.timestamp, e.what());
         }
       }
+      world_from_cam.push_back(result.world_from_cam);
       if (i == 0) continue;  // the keyframe itself
       if (IsTracked(result.status)) {
         correlation_sum += result.tracking.intensity_correlation;
@@ -63,6 +67,9 @@ RandomStartChoice ChooseRandomStart(const Dataset& dataset, const OdometryConfig
       }
     }
     odometry.Finish();
+    candidate.corner_error_px =
+        corners != nullptr ? CornerEpipolarErrorPx(*corners, world_from_cam, dataset.camera())
+                           : std::numeric_limits<double>::quiet_NaN();
     if (tracked > 0) {
       candidate.mean_correlation = correlation_sum / tracked;
       candidate.mean_rms = rms_sum / tracked;
@@ -75,12 +82,17 @@ RandomStartChoice ChooseRandomStart(const Dataset& dataset, const OdometryConfig
   for (std::future<RandomStartCandidate>& candidate : scored) {
     choice.candidates.push_back(candidate.get());
   }
-  const auto best = std::min_element(
-      choice.candidates.begin(), choice.candidates.end(),
-      [](const RandomStartCandidate& a, const RandomStartCandidate& b) {
-        return a.untracked < b.untracked ||
-               (a.untracked == b.untracked && a.mean_correlation > b.mean_correlation);
-      });
+  choice.by_corners =
+      config.odometry.random_start_corner_check &&
+      std::all_of(choice.candidates.begin(), choice.candidates.end(),
+                  [](const RandomStartCandidate& c) { return std::isfinite(c.corner_error_px); });
+  const auto best =
+      std::min_element(choice.candidates.begin(), choice.candidates.end(),
+                       [&](const RandomStartCandidate& a, const RandomStartCandidate& b) {
+                         if (a.untracked != b.untracked) return a.untracked < b.untracked;
+                         return choice.by_corners ? a.corner_error_px < b.corner_error_px
+                                                  : a.mean_correlation > b.mean_correlation;
+                       });
   choice.init_seed = best->init_seed;
   choice.ms = MsSince(start);
   return choice;

@@ -175,10 +175,13 @@ InitialMap PrepareInitialMap(const Dataset& dataset, const OdometryConfig& confi
                 << "); the run starts from the random map\n";
     }
   }
+  // Where the two-view start fails only at its direction gate: its corners, for the random start.
+  CornerTracks unsettled_corners;
   if (config.odometry.two_view_bootstrap && config.odometry.bootstrap_passes <= 1 &&
       config.odometry.init_depth_idepth_var <= 0.0 && num_frames > 0) {
     try {
-      const TwoViewBootstrap two_view = BootstrapFromTwoViews(dataset, config, num_frames);
+      const TwoViewBootstrap two_view =
+          BootstrapFromTwoViews(dataset, config, num_frames, &unsettled_corners);
       initial.depth = two_view.depth;
       initial.run_config.odometry.init_depth_idepth_var = config.odometry.bootstrap_idepth_var;
       initial.two_view = {{"second_view", two_view.second_view},
@@ -204,22 +207,27 @@ InitialMap PrepareInitialMap(const Dataset& dataset, const OdometryConfig& confi
   if (initial.depth.empty() && initial.run_config.odometry.init_depth_idepth_var <= 0.0 &&
       config.odometry.random_start_candidates > 1 && num_frames > 1) {
     try {
-      const RandomStartChoice choice = ChooseRandomStart(dataset, initial.run_config, num_frames);
+      const RandomStartChoice choice =
+          ChooseRandomStart(dataset, initial.run_config, num_frames,
+                            unsettled_corners.positions.empty() ? nullptr : &unsettled_corners);
       initial.run_config.mapping.init_seed = choice.init_seed;
       nlohmann::json candidates = nlohmann::json::array();
       for (const RandomStartCandidate& c : choice.candidates) {
         candidates.push_back({{"init_seed", c.init_seed},
                               {"untracked", c.untracked},
                               {"mean_correlation", c.mean_correlation},
-                              {"mean_rms", c.mean_rms}});
+                              {"mean_rms", c.mean_rms},
+                              {"corner_error_px", NumberOrNull(c.corner_error_px)}});
       }
       initial.random_start = {{"init_seed", choice.init_seed},
+                              {"score", choice.by_corners ? "corners" : "correlation"},
                               {"frames", choice.frames},
                               {"candidates", candidates},
                               {"ms", choice.ms}};
       std::cerr << "pldvo run: random start: mapping.init_seed " << choice.init_seed << " of "
                 << choice.candidates.size() << " initial maps fits frames 1-" << choice.frames - 1
-                << " best, " << static_cast<int>(choice.ms) << " ms\n";
+                << (choice.by_corners ? " and frame 0's tracked corners" : "") << " best, "
+                << static_cast<int>(choice.ms) << " ms\n";
     } catch (const std::exception& e) {
       std::cerr << "pldvo run: random start choice failed (" << e.what()
                 << "); the run starts from mapping.init_seed " << config.mapping.init_seed << "\n";

@@ -67,8 +67,10 @@ struct Track {
   std::vector<cv::Point2f> positions;
 };
 
-// Tracks every live track into `next` (forward-backward checked) and drops the lost ones.
-void TrackInto(const cv::Mat& previous, const cv::Mat& next, std::vector<Track>* tracks) {
+// Tracks every live track into `next` (forward-backward checked) and moves the lost ones to
+// `lost`.
+void TrackInto(const cv::Mat& previous, const cv::Mat& next, std::vector<Track>* tracks,
+               std::vector<Track>* lost) {
   std::vector<cv::Point2f> from, to, back;
   for (const Track& track : *tracks) from.push_back(track.positions.back());
   if (from.empty()) return;
@@ -82,7 +84,10 @@ void TrackInto(const cv::Mat& previous, const cv::Mat& next, std::vector<Track>*
     const cv::Point2f d = back[i] - from[i];
     const bool inside = to[i].x >= 0.f && to[i].y >= 0.f && to[i].x <= next.cols - 1.f &&
                         to[i].y <= next.rows - 1.f;
-    if (!ok[i] || !ok_back[i] || !inside || std::hypot(d.x, d.y) > kForwardBackwardPx) continue;
+    if (!ok[i] || !ok_back[i] || !inside || std::hypot(d.x, d.y) > kForwardBackwardPx) {
+      lost->push_back(std::move((*tracks)[i]));
+      continue;
+    }
     kept.push_back(std::move((*tracks)[i]));
     kept.back().positions.push_back(to[i]);
   }
@@ -325,7 +330,7 @@ int RefinePhotometrically(const std::vector<cv::Mat>& images, const SemiDenseDep
 }
 
 TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryConfig& config,
-                                       int num_frames) {
+                                       int num_frames, CornerTracks* unsettled_tracks) {
   const auto start = WallClock::now();
   const OdometryOptions& options = config.odometry;
   const int last = std::min(num_frames, options.two_view_max_frames + 1);
@@ -342,7 +347,7 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
     throw std::runtime_error("two-view bootstrap: frame 0 has " + std::to_string(corners.size()) +
                              " corners, fewer than two_view_min_inliers");
   }
-  std::vector<Track> tracks;
+  std::vector<Track> tracks, lost;
   for (const cv::Point2f& corner : corners) tracks.push_back({{corner}});
 
   TwoViewBootstrap result;
@@ -362,7 +367,7 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
   for (int k = 1; k < last && result.second_view < 0; ++k) {
     images.push_back(dataset.Load(k).image);
     const cv::Mat next = ToGray8(images.back());
-    TrackInto(previous, next, &tracks);
+    TrackInto(previous, next, &tracks, &lost);
     previous = next;
     if (static_cast<int>(tracks.size()) < options.two_view_min_inliers) {
       throw std::runtime_error("two-view bootstrap: " + std::to_string(tracks.size()) +
@@ -424,6 +429,15 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
                       std::to_string(options.two_view_min_rotation_free_parallax_px) +
                       " px (largest rotation-free with enough corners: " + best + ")";
     if (tested > 0) {
+      // The corners fix the direction roughly: the random start's choice checks against them.
+      if (unsettled_tracks != nullptr) {
+        unsettled_tracks->positions.clear();
+        for (std::vector<Track>* set : {&lost, &tracks}) {
+          for (Track& track : *set) {
+            unsettled_tracks->positions.push_back(std::move(track.positions));
+          }
+        }
+      }
       why = "no frame that passes the parallax gates fixes the translation direction to " +
             std::to_string(options.two_view_max_direction_std_deg) + " deg (best " +
             std::to_string(best_direction_std_deg) + " deg) with the " +

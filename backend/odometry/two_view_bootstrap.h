@@ -39,6 +39,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "backend/odometry/corner_epipolar_error.h"
 #include "backend/odometry/odometry_config.h"
 #include "core/dataset.h"
 #include "core/se3.h"
@@ -75,9 +76,11 @@ double RotationFreeParallaxPx(const std::vector<cv::Point2f>& x0,
 // Runs the two-view bootstrap over the first min(num_frames, two_view_max_frames) frames of
 // `dataset` with config.mapping. Throws std::runtime_error, saying why, when frame 0 cannot be
 // loaded or has too few corners, when the tracks are lost, when no frame reaches the parallax,
-// or when the map ends without observed hypotheses.
+// when no frame passes the direction gate (then, if given, *unsettled_tracks gets every corner's
+// track, lost ones included: they fix the direction roughly, corner_epipolar_error.h), or when
+// the map ends without observed hypotheses.
 TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryConfig& config,
-                                       int num_frames);
+                                       int num_frames, CornerTracks* unsettled_tracks = nullptr);
 
 }  // namespace pldvo
 

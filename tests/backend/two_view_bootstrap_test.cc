@@ -290,12 +290,35 @@ TEST(TwoViewBootstrapTest, NearRotationIsRejectedByEitherGate) {
       OdometryConfig().odometry.two_view_min_rotation_free_parallax_px;
   const std::string by_parallax = rejection(rotation_free_gate);
   EXPECT_NE(by_parallax.find("no frame up to"), std::string::npos) << by_parallax;
+  // Corners that pass no parallax gate tell nothing of the direction: none handed out.
+  CornerTracks no_tracks;
+  EXPECT_THROW(BootstrapFromTwoViews(dataset, rotation_free_gate, kLowtexFrames, &no_tracks),
+               std::runtime_error);
+  EXPECT_TRUE(no_tracks.positions.empty());
 
   OdometryConfig direction_gate = strong_corners;
   direction_gate.odometry.two_view_min_rotation_free_parallax_px = 0.0;
   const std::string by_direction = rejection(direction_gate);
   EXPECT_NE(by_direction.find("fixes the translation direction"), std::string::npos)
       << by_direction;
+  // Failed at the direction gate: every corner's track for the random start's choice, those
+  // alive to the last frame at least two_view_min_inliers, each from frame 0 on.
+  CornerTracks unsettled;
+  EXPECT_THROW(BootstrapFromTwoViews(dataset, direction_gate, kLowtexFrames, &unsettled),
+               std::runtime_error);
+  int alive = 0;
+  for (const std::vector<cv::Point2f>& track : unsettled.positions) {
+    ASSERT_FALSE(track.empty());
+    ASSERT_LE(track.size(), static_cast<size_t>(kLowtexFrames));
+    alive += track.size() == static_cast<size_t>(kLowtexFrames);
+  }
+  EXPECT_GE(alive, direction_gate.odometry.two_view_min_inliers);
+  // The ground-truth motion fits them to the tracking's accuracy.
+  std::vector<SE3> truth;
+  for (int k = 0; k < kLowtexFrames; ++k) truth.push_back(gt[k].world_from_cam);
+  const double truth_px = CornerEpipolarErrorPx(unsettled, truth, dataset.camera());
+  std::printf("tracked corners' epipolar error against the ground truth: %.3f px\n", truth_px);
+  EXPECT_LT(truth_px, 0.5);
 }
 
 TEST(TwoViewBootstrapTest, BlankFrameHasNoCorners) {

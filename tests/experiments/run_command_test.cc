@@ -422,6 +422,8 @@ TEST(RunCommandTest, RandomStartChoosesTheBestFittingInitialMap) {
   ASSERT_TRUE(choice.is_object()) << summary.dump();
   std::printf("random start: %s\n", choice.dump().c_str());
   EXPECT_EQ(choice["frames"].get<int>(), 10);
+  // The two-view start fails at its parallax gates here: no corners to check against.
+  EXPECT_EQ(choice["score"], "correlation");
   ASSERT_EQ(choice["candidates"].size(), 3u);
   const nlohmann::json* best = nullptr;
   for (size_t c = 0; c < 3; ++c) {
@@ -465,6 +467,50 @@ TEST(RunCommandTest, RandomStartChoosesTheBestFittingInitialMap) {
                   bad_log),
             2);
   EXPECT_NE(Slurp(bad_log).find("random_start_candidates"), std::string::npos) << Slurp(bad_log);
+}
+
+// Where the two-view start fails only at its direction gate (forced here by stronger corners
+// and no rotation-free gate, as in TwoViewBootstrapTest.NearRotationIsRejectedByEitherGate),
+// the random start's candidates are ranked by the epipolar error of its tracked corners; with
+// odometry.random_start_corner_check=false by the correlation, the errors still reported.
+TEST(RunCommandTest, RandomStartChecksTheCandidatesAgainstTheTrackedCorners) {
+  const std::string kFlags = kDeterministic + std::string(" --max_frames 16") +
+                             " --set odometry.random_start_candidates=3"
+                             " --set odometry.random_start_frames=10"
+                             " --set odometry.two_view_corner_quality=0.01"
+                             " --set odometry.two_view_corner_min_distance_px=7"
+                             " --set odometry.two_view_min_rotation_free_parallax_px=0"
+                             " --set odometry.two_view_min_parallax_deg=0.2";
+  for (const bool check : {true, false}) {
+    SCOPED_TRACE(check ? "corner check" : "no corner check");
+    const std::string name = std::string("run_random_start_corners_") + (check ? "on" : "off");
+    const fs::path out = TestRoot() / name;
+    const fs::path log = TestRoot() / (name + ".log");
+    ASSERT_EQ(Pldvo("run --dataset " + SequenceDir().string() + " --out " + out.string() + kFlags +
+                        " --set odometry.random_start_corner_check=" + (check ? "true" : "false"),
+                    log),
+              0)
+        << Slurp(log);
+    EXPECT_NE(Slurp(log).find("fixes the translation direction"), std::string::npos) << Slurp(log);
+    const nlohmann::json summary = nlohmann::json::parse(Slurp(out / "summary.json"));
+    const nlohmann::json& choice = summary["random_start"];
+    ASSERT_TRUE(choice.is_object()) << summary.dump();
+    std::printf("random start: %s\n", choice.dump().c_str());
+    EXPECT_EQ(choice["score"], check ? "corners" : "correlation");
+    ASSERT_EQ(choice["candidates"].size(), 3u);
+    const nlohmann::json* best = nullptr;
+    for (const nlohmann::json& candidate : choice["candidates"]) {
+      ASSERT_EQ(candidate["untracked"].get<int>(), 0);
+      ASSERT_TRUE(candidate["corner_error_px"].is_number()) << candidate.dump();
+      EXPECT_GT(candidate["corner_error_px"].get<double>(), 0.0);
+      EXPECT_LT(candidate["corner_error_px"].get<double>(), 5.0);
+      const bool better =
+          best == nullptr || (check ? candidate["corner_error_px"] < (*best)["corner_error_px"]
+                                    : candidate["mean_correlation"] > (*best)["mean_correlation"]);
+      if (better) best = &candidate;
+    }
+    EXPECT_EQ(choice["init_seed"], (*best)["init_seed"]);
+  }
 }
 
 TEST(RunCommandTest, UnknownConfigKeyIsAnError) {

@@ -1,0 +1,39 @@
+// How well a monocular start's motion fits frame 0's tracked corners (docs/bootstrap.md, "Best of
+// several random starts").
+//
+// A start from the random map settles into one of several self-consistent pairs of map and
+// motion; on the texture-less rooms the wrong ones move 20-25 deg off the true direction and fit
+// the images about as well as the right one. Corners take no part in that start, so where they
+// fix the translation direction (the two-view bootstrap reached its direction gate) they tell the
+// starts apart: the epipolar geometry of the right motion fits them, a wrong direction does not.
+#ifndef PLDVO_BACKEND_ODOMETRY_CORNER_EPIPOLAR_ERROR_H_
+#define PLDVO_BACKEND_ODOMETRY_CORNER_EPIPOLAR_ERROR_H_
+
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "core/pinhole_camera.h"
+#include "core/se3.h"
+
+namespace pldvo {
+
+// Corners of frame 0 followed frame to frame: per corner its pixel positions in frames 0, 1, ...
+// up to the last frame it was tracked to.
+struct CornerTracks {
+  std::vector<std::vector<cv::Point2f>> positions;
+};
+
+// Frames with fewer corners tracked to them do not count.
+constexpr int kMinEpipolarCorners = 20;
+
+// For every frame k >= 1 with a pose (world_from_cam[k], frame 0 first) and at least
+// kMinEpipolarCorners corners tracked to it, the median Sampson distance of the corners to the
+// epipolar geometry E = [t]x R of cam_k <- cam_0 (t of unit length: the distance does not depend
+// on the scale), in pixels (sqrt(fx fy) times the normalised-plane distance); returns the mean
+// over those frames, and NaN when no frame counts (or every such motion is zero).
+double CornerEpipolarErrorPx(const CornerTracks& tracks, const std::vector<SE3>& world_from_cam,
+                             const PinholeCamera& camera);
+
+}  // namespace pldvo
+
+#endif  // PLDVO_BACKEND_ODOMETRY_CORNER_EPIPOLAR_ERROR_H_

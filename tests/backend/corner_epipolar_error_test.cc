@@ -1,0 +1,120 @@
+// The corners' epipolar error against a start's motion (corner_epipolar_error.h), on corners
+// projected from known points along known poses.
+#include "backend/odometry/corner_epipolar_error.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+#include <vector>
+
+namespace pldvo {
+namespace {
+
+PinholeCamera Camera() { return PinholeCamera{640, 480, 525.0, 525.0, 319.5, 239.5}; }
+
+// A camera moving sideways and forward while it turns about the vertical axis: world_from_cam of
+// frames 0..num_frames-1.
+std::vector<SE3> Motion(int num_frames, const Eigen::Vector3d& step) {
+  std::vector<SE3> poses;
+  for (int k = 0; k < num_frames; ++k) {
+    const Eigen::Matrix3d rotation =
+        Eigen::AngleAxisd(0.004 * k, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    poses.emplace_back(rotation, step * k);
+  }
+  return poses;
+}
+
+// Points 2-6 m in front of frame 0 projected into every frame, with Gaussian pixel noise; a
+// corner's track ends at the first frame it leaves the image (or at lose_after).
+CornerTracks Project(const std::vector<SE3>& world_from_cam, double noise_px, int num_corners,
+                     int lose_after = 1 << 30) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, noise_px);
+  const PinholeCamera camera = Camera();
+  CornerTracks tracks;
+  for (int i = 0; i < num_corners; ++i) {
+    const double depth = 2.0 + 4.0 * u(rng);
+    const Eigen::Vector3d in_cam0((u(rng) * camera.width - camera.cx) / camera.fx * depth,
+                                  (u(rng) * camera.height - camera.cy) / camera.fy * depth, depth);
+    const Eigen::Vector3d world = world_from_cam[0] * in_cam0;
+    std::vector<cv::Point2f> track;
+    for (size_t k = 0; k < world_from_cam.size() && static_cast<int>(k) <= lose_after; ++k) {
+      const Eigen::Vector3d p = world_from_cam[k].Inverse() * world;
+      const double x = camera.fx * p.x() / p.z() + camera.cx + noise(rng);
+      const double y = camera.fy * p.y() / p.z() + camera.cy + noise(rng);
+      if (p.z() <= 0.0 || x < 0.0 || y < 0.0 || x > camera.width || y > camera.height) break;
+      track.emplace_back(static_cast<float>(x), static_cast<float>(y));
+    }
+    tracks.positions.push_back(track);
+  }
+  return tracks;
+}
+
+// The same camera centres seen from frame 0 with their direction turned by angle_deg about the
+// vertical axis of frame 0 (a wrong start's motion; the rotations stay right).
+std::vector<SE3> TurnDirection(const std::vector<SE3>& world_from_cam, double angle_deg) {
+  const Eigen::Matrix3d turn =
+      Eigen::AngleAxisd(angle_deg * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  std::vector<SE3> turned;
+  for (const SE3& pose : world_from_cam) {
+    const SE3 cam0_from_cam = world_from_cam[0].Inverse() * pose;
+    turned.push_back(world_from_cam[0] *
+                     SE3(cam0_from_cam.rotation(), turn * cam0_from_cam.translation()));
+  }
+  return turned;
+}
+
+TEST(CornerEpipolarErrorTest, TheTrueMotionFitsNoiselessCorners) {
+  const std::vector<SE3> poses = Motion(30, Eigen::Vector3d(0.01, 0.0, 0.005));
+  const CornerTracks tracks = Project(poses, 0.0, 200);
+  EXPECT_LT(CornerEpipolarErrorPx(tracks, poses, Camera()), 1e-3);
+}
+
+TEST(CornerEpipolarErrorTest, AWrongDirectionFitsWorseThanTheNoise) {
+  // With 0.5 px of noise the true motion's median Sampson distance is about 0.67 x 0.5 px (the
+  // median of |N(0, 0.5)|); a direction 20 deg off (the texture-less rooms' wrong starts) adds a
+  // systematic error that grows with the baseline.
+  const std::vector<SE3> poses = Motion(60, Eigen::Vector3d(0.01, 0.0, 0.005));
+  const CornerTracks tracks = Project(poses, 0.5, 300);
+  const double truth = CornerEpipolarErrorPx(tracks, poses, Camera());
+  const double wrong = CornerEpipolarErrorPx(tracks, TurnDirection(poses, 20.0), Camera());
+  const double slightly = CornerEpipolarErrorPx(tracks, TurnDirection(poses, 2.0), Camera());
+  std::printf("epipolar error px: truth %.3f, 2 deg off %.3f, 20 deg off %.3f\n", truth, slightly,
+              wrong);
+  EXPECT_NEAR(truth, 0.6745 * 0.5, 0.05);
+  EXPECT_GT(wrong, 3.0 * truth);
+  EXPECT_GT(slightly, truth);
+  EXPECT_LT(slightly, wrong);
+}
+
+TEST(CornerEpipolarErrorTest, DoesNotDependOnTheScale) {
+  const std::vector<SE3> poses = Motion(30, Eigen::Vector3d(0.01, 0.002, 0.005));
+  const CornerTracks tracks = Project(poses, 0.5, 200);
+  std::vector<SE3> scaled;
+  for (const SE3& pose : poses) scaled.emplace_back(pose.rotation(), 3.0 * pose.translation());
+  EXPECT_NEAR(CornerEpipolarErrorPx(tracks, scaled, Camera()),
+              CornerEpipolarErrorPx(tracks, poses, Camera()), 1e-9);
+}
+
+TEST(CornerEpipolarErrorTest, FramesWithoutEnoughCornersOrMotionDoNotCount) {
+  const std::vector<SE3> poses = Motion(30, Eigen::Vector3d(0.01, 0.0, 0.005));
+  // Tracks lost after frame 10: frames 11.. have no corner and do not count; frames 1-10 alone
+  // give the same error as the first 11 poses.
+  const CornerTracks short_tracks = Project(poses, 0.5, 200, /*lose_after=*/10);
+  const std::vector<SE3> first(poses.begin(), poses.begin() + 11);
+  EXPECT_DOUBLE_EQ(CornerEpipolarErrorPx(short_tracks, poses, Camera()),
+                   CornerEpipolarErrorPx(short_tracks, first, Camera()));
+  // Fewer corners than kMinEpipolarCorners, or no translation at all: no frame counts.
+  EXPECT_TRUE(std::isnan(
+      CornerEpipolarErrorPx(Project(poses, 0.5, kMinEpipolarCorners - 1), poses, Camera())));
+  const std::vector<SE3> turning_in_place = Motion(30, Eigen::Vector3d::Zero());
+  EXPECT_TRUE(std::isnan(
+      CornerEpipolarErrorPx(Project(turning_in_place, 0.5, 200), turning_in_place, Camera())));
+  EXPECT_TRUE(std::isnan(CornerEpipolarErrorPx(short_tracks, {}, Camera())));
+}
+
+}  // namespace
+}  // namespace pldvo
