@@ -11,7 +11,7 @@ double CornerEpipolarErrorPx(const CornerTracks& tracks, const std::vector<SE3>&
                              const PinholeCamera& camera) {
   if (world_from_cam.empty()) return std::numeric_limits<double>::quiet_NaN();
   auto normalised = [&](const cv::Point2f& p) {
-    return Eigen::Vector3d((p.x - camera.cx) / camera.fx, (p.y - camera.cy) / camera.fy, 1.0);
+    return camera.Unproject(Eigen::Vector2d(p.x, p.y));
   };
   const double focal = std::sqrt(camera.fx * camera.fy);
   double sum = 0.0;

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <future>
-#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -67,9 +66,9 @@ RandomStartChoice ChooseRandomStart(const Dataset& dataset, const OdometryConfig
       }
     }
     odometry.Finish();
-    candidate.corner_error_px =
-        corners != nullptr ? CornerEpipolarErrorPx(*corners, world_from_cam, dataset.camera())
-                           : std::numeric_limits<double>::quiet_NaN();
+    if (corners != nullptr) {
+      candidate.corner_error_px = CornerEpipolarErrorPx(*corners, world_from_cam, dataset.camera());
+    }
     if (tracked > 0) {
       candidate.mean_correlation = correlation_sum / tracked;
       candidate.mean_rms = rms_sum / tracked;

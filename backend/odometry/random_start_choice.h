@@ -18,6 +18,7 @@
 #ifndef PLDVO_BACKEND_ODOMETRY_RANDOM_START_CHOICE_H_
 #define PLDVO_BACKEND_ODOMETRY_RANDOM_START_CHOICE_H_
 
+#include <limits>
 #include <vector>
 
 #include "backend/odometry/corner_epipolar_error.h"
@@ -34,7 +35,7 @@ struct RandomStartCandidate {
   double mean_correlation = 0.0;
   double mean_rms = 0.0;
   // CornerEpipolarErrorPx of the corners against frames 0..; NaN without corners.
-  double corner_error_px = 0.0;
+  double corner_error_px = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct RandomStartChoice {

@@ -37,15 +37,16 @@ CornerTracks Project(const std::vector<SE3>& world_from_cam, double noise_px, in
   CornerTracks tracks;
   for (int i = 0; i < num_corners; ++i) {
     const double depth = 2.0 + 4.0 * u(rng);
-    const Eigen::Vector3d in_cam0((u(rng) * camera.width - camera.cx) / camera.fx * depth,
-                                  (u(rng) * camera.height - camera.cy) / camera.fy * depth, depth);
+    const double column = u(rng) * camera.width, row = u(rng) * camera.height;
+    const Eigen::Vector3d in_cam0 = depth * camera.Unproject(Eigen::Vector2d(column, row));
     const Eigen::Vector3d world = world_from_cam[0] * in_cam0;
     std::vector<cv::Point2f> track;
     for (size_t k = 0; k < world_from_cam.size() && static_cast<int>(k) <= lose_after; ++k) {
       const Eigen::Vector3d p = world_from_cam[k].Inverse() * world;
-      const double x = camera.fx * p.x() / p.z() + camera.cx + noise(rng);
-      const double y = camera.fy * p.y() / p.z() + camera.cy + noise(rng);
-      if (p.z() <= 0.0 || x < 0.0 || y < 0.0 || x > camera.width || y > camera.height) break;
+      if (p.z() <= 0.0) break;
+      const Eigen::Vector2d pixel = camera.Project(p);
+      const double x = pixel.x() + noise(rng), y = pixel.y() + noise(rng);
+      if (x < 0.0 || y < 0.0 || x > camera.width || y > camera.height) break;
       track.emplace_back(static_cast<float>(x), static_cast<float>(y));
     }
     tracks.positions.push_back(track);
