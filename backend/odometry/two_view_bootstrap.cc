@@ -26,6 +26,7 @@
 
 #include "backend/mapping/depth_map_io.h"
 #include "backend/mapping/depth_mapper.h"
+#include "backend/odometry/brightness_change.h"
 #include "backend/odometry/windowed_ba_keyframes.h"
 #include "backend/windowed_ba/windowed_ba_solver.h"
 #include "core/image_pyramid.h"
@@ -67,24 +68,60 @@ struct Track {
   std::vector<cv::Point2f> positions;
 };
 
-// Tracks every live track into `next` (forward-backward checked) and moves the lost ones to
-// `lost`.
-void TrackInto(const cv::Mat& previous, const cv::Mat& next, std::vector<Track>* tracks,
-               std::vector<Track>* lost) {
-  std::vector<cv::Point2f> from, to, back;
-  for (const Track& track : *tracks) from.push_back(track.positions.back());
-  if (from.empty()) return;
-  std::vector<uchar> ok, ok_back;
+// The live tracks' positions in `next` (forward-backward checked; ok[i] says which survived).
+std::vector<cv::Point2f> TrackPoints(const cv::Mat& previous, const cv::Mat& next,
+                                     const std::vector<cv::Point2f>& from, std::vector<bool>* ok) {
+  std::vector<cv::Point2f> to, back;
+  std::vector<uchar> found, found_back;
   std::vector<float> error;
   const cv::Size window(kLkWindowPx, kLkWindowPx);
-  cv::calcOpticalFlowPyrLK(previous, next, from, to, ok, error, window, kLkLevels);
-  cv::calcOpticalFlowPyrLK(next, previous, to, back, ok_back, error, window, kLkLevels);
-  std::vector<Track> kept;
-  for (size_t i = 0; i < tracks->size(); ++i) {
+  cv::calcOpticalFlowPyrLK(previous, next, from, to, found, error, window, kLkLevels);
+  cv::calcOpticalFlowPyrLK(next, previous, to, back, found_back, error, window, kLkLevels);
+  ok->assign(from.size(), false);
+  for (size_t i = 0; i < from.size(); ++i) {
     const cv::Point2f d = back[i] - from[i];
     const bool inside = to[i].x >= 0.f && to[i].y >= 0.f && to[i].x <= next.cols - 1.f &&
                         to[i].y <= next.rows - 1.f;
-    if (!ok[i] || !ok_back[i] || !inside || std::hypot(d.x, d.y) > kForwardBackwardPx) {
+    (*ok)[i] = found[i] && found_back[i] && inside && std::hypot(d.x, d.y) <= kForwardBackwardPx;
+  }
+  return to;
+}
+
+// Tracks every live track into `next_image` and moves the lost ones to `lost`; returns the frame
+// as 8-bit gray in `previous`'s intensities. LK has no gain term, so the tracks first follow the
+// frame scaled to `previous`'s mean and spread (which moves with what the camera sees), their
+// patches fit the exposure change, and the tracks follow the frame with that change undone (if
+// it moves a gray level).
+cv::Mat TrackInto(const cv::Mat& previous, const cv::Mat& next_image, std::vector<Track>* tracks,
+                  std::vector<Track>* lost) {
+  std::vector<cv::Point2f> from;
+  for (const Track& track : *tracks) from.push_back(track.positions.back());
+  if (from.empty()) return ToGray8(next_image);
+  cv::Scalar previous_mean, previous_std, next_mean, next_std;
+  cv::meanStdDev(previous, previous_mean, previous_std);
+  cv::meanStdDev(next_image, next_mean, next_std);
+  BrightnessChange spread;
+  if (previous_std[0] > 0.0 && next_std[0] > 0.0) {
+    spread.gain = next_std[0] / previous_std[0];
+    spread.offset = next_mean[0] - spread.gain * previous_mean[0];
+  }
+  std::vector<bool> ok;
+  const std::vector<cv::Point2f> rough =
+      TrackPoints(previous, UndoBrightnessChange(next_image, spread), from, &ok);
+  std::vector<cv::Point2f> pairs_previous, pairs_next;
+  for (size_t i = 0; i < from.size(); ++i) {
+    if (!ok[i]) continue;
+    pairs_previous.push_back(from[i]);
+    pairs_next.push_back(rough[i]);
+  }
+  const BrightnessChange change =
+      FitBrightnessChange(previous, next_image, pairs_previous, pairs_next);
+  const cv::Mat next =
+      ChangesGrayLevels(change) ? UndoBrightnessChange(next_image, change) : ToGray8(next_image);
+  const std::vector<cv::Point2f> to = TrackPoints(previous, next, from, &ok);
+  std::vector<Track> kept;
+  for (size_t i = 0; i < tracks->size(); ++i) {
+    if (!ok[i]) {
       lost->push_back(std::move((*tracks)[i]));
       continue;
     }
@@ -92,6 +129,7 @@ void TrackInto(const cv::Mat& previous, const cv::Mat& next, std::vector<Track>*
     kept.back().positions.push_back(to[i]);
   }
   *tracks = std::move(kept);
+  return next;
 }
 
 // The relative pose frame_k <- frame_0 and the triangulated corners (frame 0 coordinates) of the
@@ -366,9 +404,7 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
   std::deque<Eigen::Vector3d> directions;
   for (int k = 1; k < last && result.second_view < 0; ++k) {
     images.push_back(dataset.Load(k).image);
-    const cv::Mat next = ToGray8(images.back());
-    TrackInto(previous, next, &tracks, &lost);
-    previous = next;
+    previous = TrackInto(previous, images.back(), &tracks, &lost);
     if (static_cast<int>(tracks.size()) < options.two_view_min_inliers) {
       throw std::runtime_error("two-view bootstrap: " + std::to_string(tracks.size()) +
                                " corners left at frame " + std::to_string(k) +
