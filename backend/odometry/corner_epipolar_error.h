@@ -27,7 +27,9 @@ struct CornerTracks {
 constexpr int kMinEpipolarCorners = 20;
 
 // For every frame k >= 1 with a pose (world_from_cam[k], frame 0 first) and at least
-// kMinEpipolarCorners corners tracked to it, the median Sampson distance of the corners to the
+// kMinEpipolarCorners corners tracked to it, the median Sampson distance of the corners that one
+// motion explains (the five-point RANSAC consensus of 0 -> k at 1 px, whatever the candidate: a
+// texture-less room's weak corners drift, and by frame 40 about half of them fit no motion) to the
 // epipolar geometry E = [t]x R of cam_k <- cam_0 (t of unit length: the distance does not depend
 // on the scale), in pixels (sqrt(fx fy) times the normalised-plane distance); returns the mean
 // over those frames, and NaN when no frame counts (or every such motion is zero).
