@@ -1,7 +1,7 @@
 // The exposure change between two frames, from the patches around corners tracked between them
-// (docs/bootstrap.md, "Exposure changes"). LK has no gain term: an auto-exposure step between
-// frames drags its tracks, so the two-view bootstrap maps each frame into the previous one's
-// intensities before it tracks the corners into it.
+// (docs/bootstrap.md, "Why the exposure matching"). LK has no gain term: an auto-exposure step
+// between frames drags its tracks, so the two-view bootstrap maps each frame into the previous
+// one's intensities before it tracks the corners into it.
 #ifndef PLDVO_BACKEND_ODOMETRY_BRIGHTNESS_CHANGE_H_
 #define PLDVO_BACKEND_ODOMETRY_BRIGHTNESS_CHANGE_H_
 

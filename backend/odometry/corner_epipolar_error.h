@@ -9,6 +9,7 @@
 #ifndef PLDVO_BACKEND_ODOMETRY_CORNER_EPIPOLAR_ERROR_H_
 #define PLDVO_BACKEND_ODOMETRY_CORNER_EPIPOLAR_ERROR_H_
 
+#include <Eigen/Core>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -26,13 +27,31 @@ struct CornerTracks {
 // Frames with fewer corners tracked to them do not count.
 constexpr int kMinEpipolarCorners = 20;
 
-// For every frame k >= 1 with a pose (world_from_cam[k], frame 0 first) and at least
-// kMinEpipolarCorners corners tracked to it, the median Sampson distance of the corners that one
-// motion explains (the five-point RANSAC consensus of 0 -> k at 1 px, whatever the candidate: a
-// texture-less room's weak corners drift, and by frame 40 about half of them fit no motion) to the
-// epipolar geometry E = [t]x R of cam_k <- cam_0 (t of unit length: the distance does not depend
-// on the scale), in pixels (sqrt(fx fy) times the normalised-plane distance); returns the mean
-// over those frames, and NaN when no frame counts (or every such motion is zero).
+// Per frame k >= 1 with at least kMinEpipolarCorners corners tracked to it, the corners that one
+// motion explains: the five-point RANSAC consensus of 0 -> k at 1 px (a texture-less room's weak
+// corners drift, and by frame 40 about half of them fit no motion), on the normalised plane. It
+// does not depend on a candidate's motion, so the random start finds it once for all of them.
+struct CornerConsensus {
+  struct Frame {
+    int k = 0;
+    std::vector<Eigen::Vector2d> in_0, in_k;  // corner i seen at in_0[i] and in_k[i]
+  };
+  std::vector<Frame> frames;
+  double focal_px = 0.0;  // sqrt(fx fy): normalised-plane distances to pixels
+};
+
+// The consensus of frames 1 .. num_frames - 1 (all of frame 0's tracks, when RANSAC finds none).
+CornerConsensus FindCornerConsensus(const CornerTracks& tracks, const PinholeCamera& camera,
+                                    int num_frames);
+
+// For every consensus frame k with a pose (world_from_cam[k], frame 0 first) that moved, the
+// median Sampson distance of its corners to the epipolar geometry E = [t]x R of cam_k <- cam_0 (t
+// of unit length: the distance does not depend on the scale), in pixels; returns the mean over
+// those frames, and NaN when no frame counts.
+double CornerEpipolarErrorPx(const CornerConsensus& consensus,
+                             const std::vector<SE3>& world_from_cam);
+
+// Both in one: the consensus of frames 1 .. world_from_cam.size() - 1, and its error.
 double CornerEpipolarErrorPx(const CornerTracks& tracks, const std::vector<SE3>& world_from_cam,
                              const PinholeCamera& camera);
 

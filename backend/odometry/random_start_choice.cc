@@ -27,6 +27,11 @@ RandomStartChoice ChooseRandomStart(const Dataset& dataset, const OdometryConfig
   std::vector<LoadedFrame> frames;
   for (int i = 0; i < choice.frames; ++i) frames.push_back(LoadFrame(dataset, i));
 
+  // The corners one motion explains, once for every candidate.
+  const CornerConsensus consensus =
+      corners != nullptr ? FindCornerConsensus(*corners, dataset.camera(), choice.frames)
+                         : CornerConsensus{};
+
   OdometryConfig base_config = config;
   base_config.odometry.parallel_mapping = false;
   base_config.odometry.compare_solver = OdometryOptions::CompareSolver::kNone;
@@ -67,7 +72,7 @@ RandomStartChoice ChooseRandomStart(const Dataset& dataset, const OdometryConfig
     }
     odometry.Finish();
     if (corners != nullptr) {
-      candidate.corner_error_px = CornerEpipolarErrorPx(*corners, world_from_cam, dataset.camera());
+      candidate.corner_error_px = CornerEpipolarErrorPx(consensus, world_from_cam);
     }
     if (tracked > 0) {
       candidate.mean_correlation = correlation_sum / tracked;
