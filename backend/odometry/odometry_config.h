@@ -207,6 +207,11 @@ struct OdometryOptions {
   // the map estimated again from the refined poses. 0 passes: the corners' poses only.
   int two_view_photometric_passes = 1;
   double two_view_photometric_outlier_factor = 0.0;
+  // Where frame 0's stereo starts (step 5): kCornerMedian, every hypothesis at the corners'
+  // median inverse depth (1 after the scale) with mapping.init_idepth_var, so that the start
+  // depends on the images alone; kRandom, mapping.init's random map of mapping.init_seed.
+  enum class TwoViewMapPrior { kCornerMedian, kRandom };
+  TwoViewMapPrior two_view_map_prior = TwoViewMapPrior::kCornerMedian;
   // Best of several random starts (backend/odometry/random_start_choice.h), monocular runs that
   // start from the random map (no two-view start): the first random_start_frames frames run from
   // random_start_candidates initial maps (mapping.init_seed, + 1000 per further candidate) and
@@ -328,6 +333,12 @@ struct OdometryOptions {
     v.Field("two_view_photometric_outlier_factor", &two_view_photometric_outlier_factor,
             "Two-view bootstrap: the photometric refinement leaves out a point's frame whose "
             "energy exceeds factor^2 x the median (DSO's outlier test; 0 = off, default 0).");
+    v.Choice("two_view_map_prior", &two_view_map_prior,
+             ChoiceNames<TwoViewMapPrior>{{"corner_median", TwoViewMapPrior::kCornerMedian},
+                                          {"random", TwoViewMapPrior::kRandom}},
+             "Two-view bootstrap: frame 0's stereo starts from the corners' median inverse "
+             "depth (corner_median, default) or from the random map of mapping.init_seed "
+             "(random).");
     v.Field(
         "random_start_candidates", &random_start_candidates,
         "Monocular runs from the random map: initial maps tried over the first "

@@ -505,13 +505,18 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
   }
   const double scale = Median(idepths);
 
-  // Frame 0's map from the random initialisation, fused with frames 1..k in order (small
-  // baselines first, as in the run); each photometric pass (step 5) refines the poses and the map
-  // is estimated again from them.
+  // Frame 0's map, every hypothesis from the corners' median (or the random map: the option),
+  // fused with frames 1..k in order (small baselines first, as in the run); each photometric pass
+  // refines the poses and the map is estimated again from them.
   std::vector<SE3> poses;
   for (int j = 0; j <= k; ++j) poses.emplace_back(rotations[j], translations[j] * scale);
+  MappingOptions map_options = config.mapping;
+  if (options.two_view_map_prior == OdometryOptions::TwoViewMapPrior::kCornerMedian) {
+    map_options.init = MappingOptions::Init::kConstant;
+    map_options.init_idepth = 1.0;  // the corners' median after the scale
+  }
   auto estimate_map = [&]() {
-    auto mapper = std::make_unique<DepthMapper>(camera, config.mapping);
+    auto mapper = std::make_unique<DepthMapper>(camera, map_options);
     mapper->InitializeKeyframe(images[0], EdgeTrace());
     for (int j = 1; j <= k; ++j) mapper->UpdateWithFrame(images[j], poses[j], {});
     return mapper;

@@ -23,9 +23,10 @@
 //      direction uncertain; a wrong decomposition or local minimum jumps from frame to frame;
 //   4. the poses of frames 1..k and all inlier corners are adjusted over every frame 0..k,
 //      starting from poses interpolated between frame 0 and the two-view pose;
-//   5. frame 0's semi-dense map is estimated from the random initialisation by the mapping's own
-//      stereo and EKF with the poses of frames 1..k (photometric stereo, no lines: configurations
-//      with the same gates start alike), with the scale set by a median corner inverse depth of 1;
+//   5. with the scale set by a median corner inverse depth of 1, frame 0's semi-dense map is
+//      estimated from that median (two_view_map_prior; the map does not depend on the seed) by
+//      the mapping's own stereo and EKF with the poses of frames 1..k (photometric stereo, no
+//      lines: configurations with the same gates start alike);
 //      then, for each of two_view_photometric_passes, up to 8 evenly spaced frames 0..k and
 //      2000 of the map's points are adjusted photometrically (the windowed BA's eq. 2 rows,
 //      frame 0 hosting; DSO's initialiser adjusts poses and depths jointly in the same way),
