@@ -219,7 +219,7 @@ struct OdometryOptions {
   // intensity correlation). 1 = the one map of mapping.init_seed (paper.yaml). With
   // random_start_corner_check, where the two-view start failed only at its direction gate, the
   // lowest epipolar error of its tracked corners decides instead of the correlation.
-  int random_start_candidates = 3;
+  int random_start_candidates = 5;
   int random_start_frames = 60;
   bool random_start_corner_check = true;
   // Solver comparison (docs/tracking.md): every tracked frame's final tracking problem (the same
@@ -342,7 +342,7 @@ struct OdometryOptions {
     v.Field(
         "random_start_candidates", &random_start_candidates,
         "Monocular runs from the random map: initial maps tried over the first "
-        "random_start_frames frames; the run starts from the best fitting (1 = off; default 3).");
+        "random_start_frames frames; the run starts from the best fitting (1 = off; default 5).");
     v.Field("random_start_frames", &random_start_frames,
             "Frames each random-start candidate runs before the choice (default 60).");
     v.Field("random_start_corner_check", &random_start_corner_check,

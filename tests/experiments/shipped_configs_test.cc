@@ -77,7 +77,7 @@ void ExpectExtras(const OdometryConfig& config, bool on, const std::string& name
   }
   EXPECT_EQ(config.odometry.line_consensus_max_cost_drop, on ? 8.4 : 0.0);
   EXPECT_EQ(config.odometry.random_map_warmup_updates, on ? 3 : 0);
-  EXPECT_EQ(config.odometry.random_start_candidates, on ? 3 : 1);
+  EXPECT_EQ(config.odometry.random_start_candidates, on ? 5 : 1);
   EXPECT_EQ(config.tracking.problem.weighting.intensity_noise,
             on ? NoiseSource::kEstimated : NoiseSource::kFixed);
   EXPECT_EQ(config.keyframes.max_rms_growth, on ? 1.5 : 0.0);
