@@ -193,7 +193,7 @@ struct OdometryOptions {
   double two_view_min_parallax_deg = 2.0;
   double two_view_min_rotation_free_parallax_px = 3.0;
   int two_view_min_inliers = 30;
-  int two_view_max_frames = 60;
+  int two_view_max_frames = 90;
   // Its corners: cv::goodFeaturesToTrack's quality (relative to the strongest corner) and spacing;
   // the second view's adjusted translation direction: its largest standard deviation, and how
   // many consecutive frames' directions must agree to within that.
@@ -313,7 +313,7 @@ struct OdometryOptions {
     v.Field("two_view_min_inliers", &two_view_min_inliers,
             "Two-view bootstrap: triangulated essential-matrix inliers needed (default 30).");
     v.Field("two_view_max_frames", &two_view_max_frames,
-            "Two-view bootstrap: frames searched for the second view (default 60).");
+            "Two-view bootstrap: frames searched for the second view (default 90).");
     v.Field("two_view_corner_quality", &two_view_corner_quality,
             "Two-view bootstrap: smallest corner response relative to frame 0's strongest "
             "(cv::goodFeaturesToTrack qualityLevel, default 0.001).");

@@ -77,9 +77,10 @@ double RotationFreeParallaxPx(const std::vector<cv::Point2f>& x0,
 // Runs the two-view bootstrap over the first min(num_frames, two_view_max_frames) frames of
 // `dataset` with config.mapping. Throws std::runtime_error, saying why, when frame 0 cannot be
 // loaded or has too few corners, when the tracks are lost, when no frame reaches the parallax,
-// when no frame passes the direction gate (then, if given, *unsettled_tracks gets every corner's
-// track, lost ones included: they fix the direction roughly, corner_epipolar_error.h), or when
-// the map ends without observed hypotheses.
+// when no frame passes the direction gate (then, and when the tracks are lost after a frame
+// passed the parallax gates, *unsettled_tracks, if given, gets every corner's track, lost ones
+// included: they fix the direction roughly, corner_epipolar_error.h), or when the map ends
+// without observed hypotheses.
 TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryConfig& config,
                                        int num_frames, CornerTracks* unsettled_tracks = nullptr);
 

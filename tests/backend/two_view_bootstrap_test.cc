@@ -351,6 +351,60 @@ TEST(TwoViewBootstrapTest, NearRotationIsRejectedByEitherGate) {
   EXPECT_LT(truth_px, 0.5);
 }
 
+// Corners lost after frames passed the parallax gates (a frame of noise after the near-rotation
+// start's frames) fix the direction roughly over the frames they lasted: their tracks go to the
+// random start's choice when they lasted over its random_start_frames, as when the direction
+// gate fails; lost earlier, they would leave its later frames (where a wrong start shows)
+// unchecked, and none go.
+TEST(TwoViewBootstrapTest, CornersLostAfterTheParallaxGatesCheckTheRandomStartOverItsFrames) {
+  constexpr int kLowtexFrames = 12;
+  const synthetic::SynthOptions options = test::SmallLowtexOptions(150);
+  const synthetic::SyntheticSequence sequence = synthetic::MakeSequence(options);
+  std::vector<cv::Mat> images;
+  std::vector<int> frames;
+  for (int i = 0; i <= kLowtexFrames; ++i) {
+    cv::Mat image;
+    if (i < kLowtexFrames) {
+      test::RenderFrameForTest(sequence, i).image.convertTo(image, CV_32F);
+    } else {
+      image.create(images[0].size(), CV_32F);
+      cv::RNG(7).fill(image, cv::RNG::UNIFORM, 0.0, 255.0);
+    }
+    images.push_back(image);
+    frames.push_back(i);
+  }
+  const RenderedDataset dataset(sequence, images, frames);
+  OdometryConfig direction_gate;
+  direction_gate.odometry.two_view_corner_quality = 0.01;
+  direction_gate.odometry.two_view_corner_min_distance_px = 7.0;
+  direction_gate.odometry.two_view_min_rotation_free_parallax_px = 0.0;
+  const auto run = [&](int random_start_frames, CornerTracks* unsettled) -> std::string {
+    OdometryConfig config = direction_gate;
+    config.odometry.random_start_frames = random_start_frames;
+    try {
+      BootstrapFromTwoViews(dataset, config, kLowtexFrames + 1, unsettled);
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+
+  CornerTracks unsettled;
+  const std::string why = run(kLowtexFrames, &unsettled);
+  EXPECT_NE(why.find("corners left at frame 12"), std::string::npos) << why;
+  EXPECT_NE(why.find("fixes the translation direction"), std::string::npos) << why;
+  int to_frame_11 = 0;
+  for (const std::vector<cv::Point2f>& track : unsettled.positions) {
+    to_frame_11 += track.size() >= static_cast<size_t>(kLowtexFrames);
+  }
+  EXPECT_GE(to_frame_11, direction_gate.odometry.two_view_min_inliers);
+
+  CornerTracks too_short;
+  const std::string lost_early = run(kLowtexFrames + 1, &too_short);
+  EXPECT_NE(lost_early.find("corners left at frame 12"), std::string::npos) << lost_early;
+  EXPECT_TRUE(too_short.positions.empty());
+}
+
 // An auto-exposure camera: frame k's intensities scaled by a gain that swings +-30% about 1 and
 // shifted by an offset, saturating at 0 and 255 as a sensor does.
 std::vector<cv::Mat> WithExposureSwings(const std::vector<cv::Mat>& images) {
