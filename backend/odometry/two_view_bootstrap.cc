@@ -399,8 +399,7 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
   double best_free_px = -1.0;
   double best_direction_std_deg = std::numeric_limits<double>::infinity();
   int tested = 0;           // frames that passed the parallax gates
-  std::string tracks_lost;  // why the search ended early, if it did
-  int tracks_lost_at = last;
+  int tracks_lost_at = -1;  // the frame where too few corners were left, if any
   // Frame 0's view of the adjusted directions to the camera centres of the latest consecutive
   // frames that passed the parallax gates (at most two_view_stable_frames).
   std::deque<Eigen::Vector3d> directions;
@@ -408,8 +407,6 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
     images.push_back(dataset.Load(k).image);
     previous = TrackInto(previous, images.back(), &tracks, &lost);
     if (static_cast<int>(tracks.size()) < options.two_view_min_inliers) {
-      tracks_lost = std::to_string(tracks.size()) + " corners left at frame " + std::to_string(k) +
-                    ", fewer than two_view_min_inliers";
       tracks_lost_at = k;
       break;
     }
@@ -467,10 +464,14 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
                       " deg and a rotation-free parallax of " +
                       std::to_string(options.two_view_min_rotation_free_parallax_px) +
                       " px (largest rotation-free with enough corners: " + best + ")";
-    if (!tracks_lost.empty()) why = tracks_lost;
+    const bool lost_tracks = tracks_lost_at >= 0;
+    const std::string tracks_lost = std::to_string(tracks.size()) + " corners left at frame " +
+                                    std::to_string(tracks_lost_at) +
+                                    ", fewer than two_view_min_inliers";
+    if (lost_tracks) why = tracks_lost;
     // The corners fix the direction roughly: the random start's choice checks its candidates
     // against them, where they last over its frames (a wrong start shows in the later ones).
-    if (tested > 0 && (tracks_lost.empty() || tracks_lost_at >= options.random_start_frames)) {
+    if (tested > 0 && (!lost_tracks || tracks_lost_at >= options.random_start_frames)) {
       if (unsettled_tracks != nullptr) {
         unsettled_tracks->positions.clear();
         for (std::vector<Track>* set : {&lost, &tracks}) {
@@ -479,7 +480,7 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
           }
         }
       }
-      why = (tracks_lost.empty() ? "no frame" : tracks_lost + "; no earlier frame") +
+      why = (lost_tracks ? tracks_lost + "; no earlier frame" : "no frame") +
             " that passes the parallax gates fixes the translation direction to " +
             std::to_string(options.two_view_max_direction_std_deg) + " deg (best " +
             std::to_string(best_direction_std_deg) + " deg) with the " +

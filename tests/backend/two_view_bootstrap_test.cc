@@ -8,7 +8,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "backend/odometry/odometry_config.h"
@@ -263,6 +265,29 @@ TEST(TwoViewBootstrapTest, StaticCameraHasNoParallax) {
   }
 }
 
+// The small lowtex sequence's first `count` frames (CV_32F): the camera turns with little
+// translation there (the near-rotation start below).
+std::vector<cv::Mat> NearRotationFrames(const synthetic::SyntheticSequence& sequence, int count) {
+  std::vector<cv::Mat> images;
+  for (int i = 0; i < count; ++i) {
+    cv::Mat image;
+    test::RenderFrameForTest(sequence, i).image.convertTo(image, CV_32F);
+    images.push_back(image);
+  }
+  return images;
+}
+
+// What BootstrapFromTwoViews throws over `num_frames` frames, or "accepted".
+std::string Outcome(const Dataset& dataset, const OdometryConfig& config, int num_frames,
+                    CornerTracks* unsettled_tracks = nullptr) {
+  try {
+    BootstrapFromTwoViews(dataset, config, num_frames, unsettled_tracks);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
 // The start of the lowtex preset at 320x240 (seed 1, 150-frame path): the camera turns 4.3 deg
 // and moves 1.9 cm in the first 6 frames, so the corners' motion is nearly all rotation (0.6 px
 // rotation-free at frame 6). With the strongest corners only (quality 0.01, 7 px apart) the
@@ -274,25 +299,14 @@ TEST(TwoViewBootstrapTest, NearRotationIsRejectedByEitherGate) {
   constexpr int kLowtexFrames = 12;
   const synthetic::SynthOptions options = test::SmallLowtexOptions(150);
   const synthetic::SyntheticSequence sequence = synthetic::MakeSequence(options);
-  std::vector<cv::Mat> images;
-  std::vector<int> frames;
-  for (int i = 0; i < kLowtexFrames; ++i) {
-    cv::Mat image;
-    test::RenderFrameForTest(sequence, i).image.convertTo(image, CV_32F);
-    images.push_back(image);
-    frames.push_back(i);
-  }
-  const RenderedDataset dataset(sequence, images, frames);
+  std::vector<int> frames(kLowtexFrames);
+  std::iota(frames.begin(), frames.end(), 0);
+  const RenderedDataset dataset(sequence, NearRotationFrames(sequence, kLowtexFrames), frames);
   OdometryConfig strong_corners;
   strong_corners.odometry.two_view_corner_quality = 0.01;
   strong_corners.odometry.two_view_corner_min_distance_px = 7.0;
-  const auto rejection = [&](const OdometryConfig& config) -> std::string {
-    try {
-      BootstrapFromTwoViews(dataset, config, kLowtexFrames);
-    } catch (const std::runtime_error& e) {
-      return e.what();
-    }
-    return "accepted";
+  const auto rejection = [&](const OdometryConfig& config) {
+    return Outcome(dataset, config, kLowtexFrames);
   };
 
   OdometryConfig unguarded = strong_corners;
@@ -360,33 +374,21 @@ TEST(TwoViewBootstrapTest, CornersLostAfterTheParallaxGatesCheckTheRandomStartOv
   constexpr int kLowtexFrames = 12;
   const synthetic::SynthOptions options = test::SmallLowtexOptions(150);
   const synthetic::SyntheticSequence sequence = synthetic::MakeSequence(options);
-  std::vector<cv::Mat> images;
-  std::vector<int> frames;
-  for (int i = 0; i <= kLowtexFrames; ++i) {
-    cv::Mat image;
-    if (i < kLowtexFrames) {
-      test::RenderFrameForTest(sequence, i).image.convertTo(image, CV_32F);
-    } else {
-      image.create(images[0].size(), CV_32F);
-      cv::RNG(7).fill(image, cv::RNG::UNIFORM, 0.0, 255.0);
-    }
-    images.push_back(image);
-    frames.push_back(i);
-  }
+  std::vector<cv::Mat> images = NearRotationFrames(sequence, kLowtexFrames);
+  cv::Mat noise(images[0].size(), CV_32F);
+  cv::RNG(7).fill(noise, cv::RNG::UNIFORM, 0.0, 255.0);
+  images.push_back(noise);
+  std::vector<int> frames(kLowtexFrames + 1);
+  std::iota(frames.begin(), frames.end(), 0);
   const RenderedDataset dataset(sequence, images, frames);
   OdometryConfig direction_gate;
   direction_gate.odometry.two_view_corner_quality = 0.01;
   direction_gate.odometry.two_view_corner_min_distance_px = 7.0;
   direction_gate.odometry.two_view_min_rotation_free_parallax_px = 0.0;
-  const auto run = [&](int random_start_frames, CornerTracks* unsettled) -> std::string {
+  const auto run = [&](int random_start_frames, CornerTracks* unsettled) {
     OdometryConfig config = direction_gate;
     config.odometry.random_start_frames = random_start_frames;
-    try {
-      BootstrapFromTwoViews(dataset, config, kLowtexFrames + 1, unsettled);
-    } catch (const std::runtime_error& e) {
-      return e.what();
-    }
-    return "accepted";
+    return Outcome(dataset, config, kLowtexFrames + 1, unsettled);
   };
 
   CornerTracks unsettled;
