@@ -56,6 +56,12 @@ struct ProblemBuilderOptions {
   // rest of the view through a row-wise robust loss (docs/tracking.md, "Rows per edge"). 0: off
   // (paper.yaml); 50 measured as 20 on the development set (both 0.85x the RPE without).
   double max_rows_per_edge = 50.0;
+  // The same cap on the point-to-line rows of one keyframe edge (eq. 3): its pixels share the
+  // matched line's detection error and the edge's depth error. 0: off.
+  double max_line_rows_per_edge = 0.0;
+  // The point-to-line rows enter the levels >= this one only: coarser levels widen the basin
+  // with them, finer ones are solved on the photometric rows alone. 0: every level.
+  int line_finest_level = 0;
   WeightingOptions weighting;
 
   template <class Visitor>
@@ -74,6 +80,11 @@ struct ProblemBuilderOptions {
     v.Field("max_rows_per_edge", &max_rows_per_edge,
             "Photometric rows of one keyframe edge count as at most this many points (each "
             "row's weight scaled by sqrt(cap / n)); 0 = off (default 50).");
+    v.Field("max_line_rows_per_edge", &max_line_rows_per_edge,
+            "Point-to-line rows of one keyframe edge count as at most this many points (each "
+            "row's weight scaled by sqrt(cap / n)); 0 = off (default 0).");
+    v.Field("line_finest_level", &line_finest_level,
+            "Point-to-line rows only at pyramid levels >= this one (0 = every level).");
     v.Section("weighting", &weighting, "Weighting of the residual families and robust loss.");
   }
   std::string Check() const;

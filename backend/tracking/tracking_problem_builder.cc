@@ -38,6 +38,10 @@ std::string ProblemBuilderOptions::Check() const {
   if (!(max_rows_per_edge >= 0.0) || !std::isfinite(max_rows_per_edge)) {
     return "max_rows_per_edge must be >= 0 and finite";
   }
+  if (line_finest_level < 0) return "line_finest_level must be >= 0";
+  if (!(max_line_rows_per_edge >= 0.0) || !std::isfinite(max_line_rows_per_edge)) {
+    return "max_line_rows_per_edge must be >= 0 and finite";
+  }
   if (!(brightness_prior_sigma_a > 0.0) || !(brightness_prior_sigma_b > 0.0) ||
       !std::isfinite(brightness_prior_sigma_a) || !std::isfinite(brightness_prior_sigma_b)) {
     return "brightness_prior_sigma_a and brightness_prior_sigma_b must be positive and finite";
@@ -138,6 +142,7 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
   const size_t batch = loss_in_problem_ ? 1 : static_cast<size_t>(options_.batch_size);
 
   const std::vector<double> edge_row_scale = EdgeRowScales(ref, options_.max_rows_per_edge);
+  const std::vector<double> line_row_scale = EdgeRowScales(ref, options_.max_line_rows_per_edge);
 
   BuildStatistics stats;
   if (UsesPhotometric(weighting.policy)) {
@@ -174,7 +179,9 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
   const bool shared_line_error = weighting.line_error_model == LineErrorModel::kSharedPerEdge &&
                                  (weighting.policy == WeightingPolicy::kCovariance ||
                                   weighting.policy == WeightingPolicy::kLineOnly);
-  if (shared_line_error) {
+  if (level < options_.line_finest_level) {
+    // Photometric rows only at this level.
+  } else if (shared_line_error) {
     AddSharedLineErrorBlocks(ref, level, pose, line_cov_scale, loss_inside, cur_from_ref, problem,
                              &stats);
   } else if (UsesLines(weighting.policy)) {
@@ -195,9 +202,12 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
       if (line == nullptr) continue;
       LineWithCovariance line_in_cur = line->line_in_cur;
       line_in_cur.cov *= line_cov_scale;
-      const double sqrt_info = LineSqrtInfo(weighting, camera, pose, point.pixel_on_edge,
-                                            point.idepth, point.idepth_var, line_in_cur);
+      double sqrt_info = LineSqrtInfo(weighting, camera, pose, point.pixel_on_edge, point.idepth,
+                                      point.idepth_var, line_in_cur);
       if (!(sqrt_info > 0.0)) continue;
+      if (point.edge_id < static_cast<int>(line_row_scale.size())) {
+        sqrt_info *= line_row_scale[point.edge_id];
+      }
       PointToLineObservation observation;
       observation.pixel_in_ref = point.pixel_on_edge;
       observation.idepth = point.idepth;

@@ -22,7 +22,9 @@
 // robust loss is passed with it as a ceres::LossFunction instead. With line_error_model
 // shared_per_edge (builder "tracking" only) the point-to-line rows form one block per edge,
 // whitened against the line error its pixels share. With max_rows_per_edge > 0 the photometric
-// rows of an edge with more points than that are down-weighted (EdgeRowScales).
+// rows of an edge with more points than that are down-weighted (EdgeRowScales), and with
+// max_line_rows_per_edge > 0 its point-to-line rows alike; levels below line_finest_level get no
+// point-to-line rows.
 #ifndef PLDVO_BACKEND_TRACKING_TRACKING_PROBLEM_BUILDER_H_
 #define PLDVO_BACKEND_TRACKING_TRACKING_PROBLEM_BUILDER_H_
 

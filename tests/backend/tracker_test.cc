@@ -169,7 +169,33 @@ TEST(ProblemBuilderTest, PoliciesSelectResidualFamiliesAndBatching) {
             stats[WeightingPolicy::kLineOnly].line_residuals);
 }
 
-TEST(ProblemBuilderTest, MaxRowsPerEdgeCapsTheInformationOfEachEdge) {
+TEST(ProblemBuilderTest, LineFinestLevelLeavesTheFinerLevelsPhotometric) {
+  const FramePair& pair = Pair("lowtex");
+  const TrackingReference reference =
+      MakePairReference(pair, GroundTruthReferenceOptions(), /*with_edges=*/true);
+  const ImagePyramid current(pair.cur_image, 4);
+  const auto build = [&](int line_finest_level, int level) {
+    ProblemBuilderOptions options;
+    options.line_finest_level = line_finest_level;
+    double pose[7];
+    PoseToParameters(pair.cur_from_ref, pose);
+    LeastSquaresProblem problem;
+    return MakeProblemBuilder("tracking", options)
+        ->Build(reference, current, level, pose, nullptr, &problem);
+  };
+  for (int level = 0; level < 3; ++level) {
+    const BuildStatistics every_level = build(0, level);
+    const BuildStatistics from_level_1 = build(1, level);
+    ASSERT_GT(every_level.line_residuals, 0) << "level " << level;
+    EXPECT_EQ(from_level_1.line_residuals, level < 1 ? 0 : every_level.line_residuals);
+    EXPECT_EQ(from_level_1.photometric_residuals, every_level.photometric_residuals);
+  }
+  ProblemBuilderOptions bad;
+  bad.line_finest_level = -1;
+  EXPECT_THROW(MakeProblemBuilder("tracking", bad), std::invalid_argument);
+}
+
+TEST(ProblemBuilderTest, RowsPerEdgeCapsCapTheInformationOfEachEdge) {
   const FramePair& pair = Pair("lowtex");
   const TrackingReference reference =
       MakePairReference(pair, GroundTruthReferenceOptions(), /*with_edges=*/true);
@@ -198,15 +224,19 @@ TEST(ProblemBuilderTest, MaxRowsPerEdgeCapsTheInformationOfEachEdge) {
   ASSERT_GT(count[longest], 2 * kCap);
 
   // The problem of one level: without a robust loss the cost of an edge's rows scales by
-  // cap / n, the cost of points on no edge does not change.
-  const auto cost = [&](const std::vector<ReferencePoint>& points, double cap) {
+  // cap / n, the cost of points on no edge does not change. Each family's cap (photometric:
+  // max_rows_per_edge, point-to-line: max_line_rows_per_edge) leaves the other family's rows as
+  // they are.
+  const auto cost = [&](const std::vector<ReferencePoint>& points, WeightingPolicy policy,
+                        double photometric_cap, double line_cap) {
     TrackingReference only = reference;
     only.levels.resize(1);
     only.levels[0].points = points;
     ProblemBuilderOptions options;
-    options.weighting.policy = WeightingPolicy::kPhotometricOnly;
+    options.weighting.policy = policy;
     options.weighting.robust_loss = RobustLossKind::kNone;
-    options.max_rows_per_edge = cap;
+    options.max_rows_per_edge = photometric_cap;
+    options.max_line_rows_per_edge = line_cap;
     double pose[7];
     PoseToParameters(
         SE3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.01, 0, 0)) * pair.cur_from_ref, pose);
@@ -221,15 +251,26 @@ TEST(ProblemBuilderTest, MaxRowsPerEdgeCapsTheInformationOfEachEdge) {
     if (point.edge_id == longest) on_longest.push_back(point);
     if (point.edge_id < 0) on_no_edge.push_back(point);
   }
-  const double uncapped = cost(on_longest, 0.0);
-  ASSERT_GT(uncapped, 0.0);
-  EXPECT_NEAR(cost(on_longest, kCap) / uncapped, kCap / count[longest], 1e-9);
+  constexpr WeightingPolicy kPhotometric = WeightingPolicy::kPhotometricOnly;
+  constexpr WeightingPolicy kLines = WeightingPolicy::kLineOnly;
+  const double photometric = cost(on_longest, kPhotometric, 0.0, 0.0);
+  const double lines = cost(on_longest, kLines, 0.0, 0.0);
+  ASSERT_GT(photometric, 0.0);
+  ASSERT_GT(lines, 0.0);
+  const double ratio = kCap / count[longest];
+  EXPECT_NEAR(cost(on_longest, kPhotometric, kCap, 0.0) / photometric, ratio, 1e-9);
+  EXPECT_NEAR(cost(on_longest, kLines, 0.0, kCap) / lines, ratio, 1e-9);
+  EXPECT_EQ(cost(on_longest, kPhotometric, 0.0, kCap), photometric);
+  EXPECT_EQ(cost(on_longest, kLines, kCap, 0.0), lines);
   if (!on_no_edge.empty()) {
-    EXPECT_EQ(cost(on_no_edge, kCap), cost(on_no_edge, 0.0));
+    EXPECT_EQ(cost(on_no_edge, kPhotometric, kCap, kCap), cost(on_no_edge, kPhotometric, 0, 0));
   }
 
   ProblemBuilderOptions bad;
   bad.max_rows_per_edge = -1.0;
+  EXPECT_THROW(MakeProblemBuilder("tracking", bad), std::invalid_argument);
+  bad = ProblemBuilderOptions();
+  bad.max_line_rows_per_edge = -1.0;
   EXPECT_THROW(MakeProblemBuilder("tracking", bad), std::invalid_argument);
 }
 
