@@ -57,7 +57,8 @@ struct ProblemBuilderOptions {
   // (paper.yaml); 50 measured as 20 on the development set (both 0.85x the RPE without).
   double max_rows_per_edge = 50.0;
   // The same cap on the point-to-line rows of one keyframe edge (eq. 3): its pixels share the
-  // matched line's detection error and the edge's depth error. 0: off.
+  // matched line's detection error and the edge's depth error. 0: off. Per-pixel line error
+  // model only (shared_per_edge already whitens an edge's rows together).
   double max_line_rows_per_edge = 0.0;
   // The point-to-line rows enter the levels >= this one only: coarser levels widen the basin
   // with them, finer ones are solved on the photometric rows alone. 0: every level.

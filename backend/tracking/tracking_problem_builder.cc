@@ -142,7 +142,6 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
   const size_t batch = loss_in_problem_ ? 1 : static_cast<size_t>(options_.batch_size);
 
   const std::vector<double> edge_row_scale = EdgeRowScales(ref, options_.max_rows_per_edge);
-  const std::vector<double> line_row_scale = EdgeRowScales(ref, options_.max_line_rows_per_edge);
 
   BuildStatistics stats;
   if (UsesPhotometric(weighting.policy)) {
@@ -179,12 +178,12 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
   const bool shared_line_error = weighting.line_error_model == LineErrorModel::kSharedPerEdge &&
                                  (weighting.policy == WeightingPolicy::kCovariance ||
                                   weighting.policy == WeightingPolicy::kLineOnly);
-  if (level < options_.line_finest_level) {
-    // Photometric rows only at this level.
-  } else if (shared_line_error) {
+  const bool lines_at_level = level >= options_.line_finest_level;
+  if (lines_at_level && shared_line_error) {
     AddSharedLineErrorBlocks(ref, level, pose, line_cov_scale, loss_inside, cur_from_ref, problem,
                              &stats);
-  } else if (UsesLines(weighting.policy)) {
+  } else if (lines_at_level && UsesLines(weighting.policy)) {
+    const std::vector<double> line_row_scale = EdgeRowScales(ref, options_.max_line_rows_per_edge);
     std::vector<PointToLineObservation> observations;
     observations.reserve(batch);
     auto flush = [&]() {

@@ -263,7 +263,7 @@ TEST(ProblemBuilderTest, RowsPerEdgeCapsCapTheInformationOfEachEdge) {
   EXPECT_EQ(cost(on_longest, kPhotometric, 0.0, kCap), photometric);
   EXPECT_EQ(cost(on_longest, kLines, kCap, 0.0), lines);
   if (!on_no_edge.empty()) {
-    EXPECT_EQ(cost(on_no_edge, kPhotometric, kCap, kCap), cost(on_no_edge, kPhotometric, 0, 0));
+    EXPECT_EQ(cost(on_no_edge, kPhotometric, kCap, kCap), cost(on_no_edge, kPhotometric, 0.0, 0.0));
   }
 
   ProblemBuilderOptions bad;
