@@ -170,5 +170,11 @@ for d in "${datasets[@]}"; do
         "RPE %.2f [%.2f, %.2f] cm/s\n", d, c, m, v[1], v[NR] }'
   done
 done
+# Over the sequences: the geometric mean of the per-sequence ratios with its bootstrap interval
+# and the sign test (docs/benchmark.md, "Comparing two configurations").
+echo
+echo "points_lines against sdvo over the sequences (RPE cm/s, pldvo compare):"
+"$pldvo" compare --baseline "$ablation" --baseline_config sdvo --candidate "$ablation" \
+  --candidate_config points_lines | sed -n '/^sequences compared/,$p'
 echo
 echo "Tables of the ablation: $ablation/results.md; runs: $ablation/runs/"

@@ -7,3 +7,4 @@ DEFINE_string(camera, "",
               "folder's calibration.");
 DEFINE_string(config, "", "Configuration YAML (docs/configuration.md); --set overrides it.");
 DEFINE_string(out, "", "Output directory (created if missing).");
+DEFINE_bool(json, false, "Print one JSON object instead of the text summary.");

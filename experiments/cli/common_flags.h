@@ -11,5 +11,6 @@ DECLARE_string(format);
 DECLARE_string(camera);
 DECLARE_string(config);
 DECLARE_string(out);
+DECLARE_bool(json);
 
 #endif  // PLDVO_EXPERIMENTS_CLI_COMMON_FLAGS_H_

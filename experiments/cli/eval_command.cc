@@ -17,10 +17,10 @@
 #include "core/evaluation.h"
 #include "core/trajectory_io.h"
 #include "experiments/cli/command.h"
+#include "experiments/cli/common_flags.h"
 
 DEFINE_string(gt, "", "Ground-truth trajectory, TUM format (timestamp tx ty tz qx qy qz qw).");
 DEFINE_string(est, "", "Estimated trajectory, TUM format.");
-DEFINE_bool(json, false, "Print one JSON object instead of the text summary.");
 DEFINE_string(motion_errors, "",
               "Also write the error of every frame-to-frame motion to this CSV "
               "(docs/evaluation.md, \"Per-frame motion errors\").");
@@ -104,6 +104,6 @@ int RunEval(const CommandContext& context) {
 
 PLDVO_REGISTER_COMMAND("eval",
                        "ATE, RPE and coverage of a TUM-format trajectory against ground truth.",
-                       RunEval);
+                       RunEval, "json");
 
 }  // namespace pldvo
