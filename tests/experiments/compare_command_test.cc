@@ -15,15 +15,9 @@ namespace pldvo {
 namespace {
 
 namespace fs = std::filesystem;
+using test::Pldvo;
 using test::Slurp;
 using test::TestRoot;
-
-int Pldvo(const std::string& args, const fs::path& log) {
-  const std::string command =
-      std::string(PLDVO_BINARY) + " " + args + " > " + log.string() + " 2>&1";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 // An ablation folder with results.csv in `pldvo ablate`'s column order (a subset of the columns
 // after `dir` is enough: compare reads them by name).

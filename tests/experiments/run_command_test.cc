@@ -30,6 +30,7 @@ namespace {
 namespace fs = std::filesystem;
 constexpr int kFrames = 36;  // 1.2 s: RPE needs pairs 1 s apart
 
+using test::Pldvo;
 using test::Slurp;
 using test::TestRoot;
 
@@ -55,14 +56,6 @@ int CountLines(const fs::path& path, bool skip_comments) {
     ++count;
   }
   return count;
-}
-
-// Runs the pldvo binary with `args`; stdout and stderr go to `log`. Returns the exit code.
-int Pldvo(const std::string& args, const fs::path& log) {
-  const std::string command =
-      std::string(PLDVO_BINARY) + " " + args + " > " + log.string() + " 2>&1";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 // Inline mapping, and one initial map: the choice among several random starts

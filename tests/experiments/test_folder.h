@@ -1,11 +1,14 @@
 // Test helpers for the end-to-end tests of the pldvo binary: a per-process scratch folder that is
-// removed when the test process ends, and reading a whole file.
+// removed when the test process ends, reading a whole file, and running the binary (the including
+// test target defines PLDVO_BINARY).
 #ifndef PLDVO_TESTS_EXPERIMENTS_TEST_FOLDER_H_
 #define PLDVO_TESTS_EXPERIMENTS_TEST_FOLDER_H_
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -38,6 +41,16 @@ inline std::string Slurp(const std::filesystem::path& path) {
   text << file.rdbuf();
   return text.str();
 }
+
+#ifdef PLDVO_BINARY
+// Runs the pldvo binary with `args`; stdout and stderr go to `log`. Returns the exit code.
+inline int Pldvo(const std::string& args, const std::filesystem::path& log) {
+  const std::string command =
+      std::string(PLDVO_BINARY) + " " + args + " > " + log.string() + " 2>&1";
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+#endif
 
 }  // namespace pldvo::test
 
