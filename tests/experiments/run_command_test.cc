@@ -614,20 +614,23 @@ TEST(AblateCommandTest, RepeatsRunEachPairWithItsOwnInitSeed) {
 // `--collect`, gives the results of one unsharded run (deterministic mode): results.csv equal
 // field by field except the timing columns (wall-clock) and the run folder (another OUT), and
 // results.json's non-timing statistics equal. Grid: 2 configs x 1 sequence x 2 repeats; under the
-// sanitizers (docs/reliability.md) points_lines only, the same bookkeeping on half the runs.
+// sanitizers (docs/reliability.md) points_lines only on the first 12 frames (RPE over 0.2 s), the
+// same bookkeeping on half the runs.
 TEST(AblateCommandTest, ShardsThenCollectGiveTheResultsOfOneRun) {
   const fs::path configs = fs::path(PLDVO_SOURCE_DIR) / "experiments" / "configs";
 #ifdef PLDVO_SANITIZE
   const std::string config_list = (configs / "points_lines.yaml").string();
   const size_t num_configs = 1;
+  const std::string frames = " --run_max_frames 12 --set evaluation.rpe_delta=0.2";
 #else
   const std::string config_list =
       (configs / "sdvo.yaml").string() + "," + (configs / "points_lines.yaml").string();
   const size_t num_configs = 2;
+  const std::string frames;
 #endif
   const size_t num_runs = 2 * num_configs;
   const std::string grid = " --configs " + config_list + " --datasets " + SequenceDir().string() +
-                           " --repeats 2" + kDeterministic;
+                           " --repeats 2" + kDeterministic + frames;
   const fs::path one = TestRoot() / "ablate_one", sharded = TestRoot() / "ablate_sharded";
   const fs::path log = TestRoot() / "ablate_shards.log";
   ASSERT_EQ(Pldvo("ablate" + grid + " --out " + one.string() + " --jobs 2", log), 0) << Slurp(log);
