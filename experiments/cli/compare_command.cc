@@ -91,18 +91,16 @@ std::vector<RunFigure> ReadRuns(const std::string& where, const std::string& con
     configs.insert(fields[config_column]);
     rows.push_back(std::move(fields));
   }
+  std::string names;  // for the errors
+  for (const std::string& name : configs) names += " " + name;
   std::string chosen = config;
   if (chosen.empty()) {
     if (configs.size() != 1) {
-      std::string names;
-      for (const std::string& name : configs) names += " " + name;
       throw UsageError(path.string() + " holds " + std::to_string(configs.size()) +
                        " configs; choose one with --baseline_config / --candidate_config:" + names);
     }
     chosen = *configs.begin();
   } else if (configs.count(chosen) == 0) {
-    std::string names;
-    for (const std::string& name : configs) names += " " + name;
     throw UsageError(path.string() + " has no config '" + chosen + "'; it has:" + names);
   }
   *config_used = chosen;
