@@ -18,36 +18,40 @@
 
 namespace pldvo {
 
-// Corners of frame 0 followed frame to frame: per corner its pixel positions in frames 0, 1, ...
-// up to the last frame it was tracked to.
+// Corners followed frame to frame: per corner its pixel positions in frames a, a + 1, ... up to
+// the last frame it was tracked to, a its anchor (the frame it was detected in). Frame 0's corners
+// have anchor 0; where they were lost early, corners detected later take over (re-anchored).
 struct CornerTracks {
   std::vector<std::vector<cv::Point2f>> positions;
+  std::vector<int> anchors;  // per track; empty: every track from frame 0
+  int Anchor(size_t track) const { return anchors.empty() ? 0 : anchors[track]; }
 };
 
 // Frames with fewer corners tracked to them do not count.
 constexpr int kMinEpipolarCorners = 20;
 
-// Per frame k >= 1 with at least kMinEpipolarCorners corners tracked to it, the corners that one
-// motion explains: the five-point RANSAC consensus of 0 -> k at 1 px (a texture-less room's weak
-// corners drift, and by frame 40 about half of them fit no motion), on the normalised plane. It
-// does not depend on a candidate's motion, so the random start finds it once for all of them.
+// Per anchor a and frame k > a with at least kMinEpipolarCorners of a's corners tracked to it, the
+// corners that one motion explains: the five-point RANSAC consensus of a -> k at 1 px (a
+// texture-less room's weak corners drift, and by frame 40 about half of them fit no motion), on the
+// normalised plane. It does not depend on a candidate's motion, so the random start finds it once
+// for all of them.
 struct CornerConsensus {
   struct Frame {
-    int k = 0;
-    std::vector<Eigen::Vector2d> in_0, in_k;  // corner i seen at in_0[i] and in_k[i]
+    int anchor = 0, k = 0;
+    std::vector<Eigen::Vector2d> in_0, in_k;  // corner i seen at in_0[i] (anchor) and in_k[i]
   };
   std::vector<Frame> frames;
   double focal_px = 0.0;  // sqrt(fx fy): normalised-plane distances to pixels
 };
 
-// The consensus of frames 1 .. num_frames - 1 (all of frame 0's tracks, when RANSAC finds none).
+// The consensus of frames 1 .. num_frames - 1 (all of an anchor's tracks, when RANSAC finds none).
 CornerConsensus FindCornerConsensus(const CornerTracks& tracks, const PinholeCamera& camera,
                                     int num_frames);
 
-// For every consensus frame k with a pose (world_from_cam[k], frame 0 first) that moved, the
-// median Sampson distance of its corners to the epipolar geometry E = [t]x R of cam_k <- cam_0 (t
-// of unit length: the distance does not depend on the scale), in pixels; returns the mean over
-// those frames, and NaN when no frame counts.
+// For every consensus frame k with a pose (world_from_cam[k], frame 0 first) that moved from its
+// anchor a, the median Sampson distance of its corners to the epipolar geometry E = [t]x R of
+// cam_k <- cam_a (t of unit length: the distance does not depend on the scale), in pixels; returns
+// the mean over those frames, and NaN when no frame counts.
 double CornerEpipolarErrorPx(const CornerConsensus& consensus,
                              const std::vector<SE3>& world_from_cam);
 

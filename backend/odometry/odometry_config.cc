@@ -51,6 +51,7 @@ std::string OdometryOptions::Check() const {
   }
   if (two_view_min_inliers < 8) return "two_view_min_inliers must be >= 8";
   if (two_view_max_frames < 1) return "two_view_max_frames must be >= 1";
+  if (two_view_max_anchor < 0) return "two_view_max_anchor must be >= 0";
   if (!(two_view_corner_quality > 0.0 && two_view_corner_quality < 1.0)) {
     return "two_view_corner_quality must be in (0, 1)";
   }

@@ -194,6 +194,11 @@ struct OdometryOptions {
   double two_view_min_rotation_free_parallax_px = 3.0;
   int two_view_min_inliers = 30;
   int two_view_max_frames = 90;
+  // Where the corners are lost (fewer than two_view_min_inliers) before a second view, the start
+  // begins again at the frame where they were lost, as long as that frame is at most
+  // two_view_max_anchor; the frames before it are tracked backwards from its map
+  // (backward_start.h). 0: frame 0 only.
+  int two_view_max_anchor = 90;
   // Its corners: cv::goodFeaturesToTrack's quality (relative to the strongest corner) and spacing;
   // the second view's adjusted translation direction: its largest standard deviation, and how
   // many consecutive frames' directions must agree to within that.
@@ -218,10 +223,13 @@ struct OdometryOptions {
   // the run starts from the one whose frames fit best (fewest not tracked, then the highest mean
   // intensity correlation). 1 = the one map of mapping.init_seed (paper.yaml). With
   // random_start_corner_check, where the two-view start failed only at its direction gate, the
-  // lowest epipolar error of its tracked corners decides instead of the correlation.
+  // lowest epipolar error of its tracked corners decides instead of the correlation; with
+  // random_start_reanchored_corners also where frame 0's corners were lost before the horizon,
+  // with corners detected again where they were lost.
   int random_start_candidates = 5;
   int random_start_frames = 60;
   bool random_start_corner_check = true;
+  bool random_start_reanchored_corners = false;
   // Solver comparison (docs/tracking.md): every tracked frame's final tracking problem (the same
   // reference, lines and initial pose) is solved a second time with this solver; its poses, RPE
   // and time are reported beside the run's (summary.json `compare_solver`,
@@ -314,6 +322,10 @@ struct OdometryOptions {
             "Two-view bootstrap: triangulated essential-matrix inliers needed (default 30).");
     v.Field("two_view_max_frames", &two_view_max_frames,
             "Two-view bootstrap: frames searched for the second view (default 90).");
+    v.Field("two_view_max_anchor", &two_view_max_anchor,
+            "Two-view bootstrap: where the corners are lost before a second view, the start "
+            "begins again at the frame where they were lost, up to this frame; the frames before "
+            "are tracked backwards from its map (0: frame 0 only; default 90).");
     v.Field("two_view_corner_quality", &two_view_corner_quality,
             "Two-view bootstrap: smallest corner response relative to frame 0's strongest "
             "(cv::goodFeaturesToTrack qualityLevel, default 0.001).");
@@ -349,6 +361,10 @@ struct OdometryOptions {
             "Random-start choice: where the two-view start failed only at its direction gate, the "
             "candidate whose poses fit its tracked corners best (epipolar error) wins instead of "
             "the best intensity correlation (default true).");
+    v.Field("random_start_reanchored_corners", &random_start_reanchored_corners,
+            "Random-start corner check also where frame 0's corners were lost within "
+            "random_start_frames: corners detected again where they were lost check the later "
+            "frames (default false).");
     v.Choice("compare_solver", &compare_solver,
              ChoiceNames<CompareSolver>{{"none", CompareSolver::kNone},
                                         {"ceres", CompareSolver::kCeres},

@@ -22,6 +22,7 @@
 #include <sstream>
 #include <utility>
 
+#include "backend/odometry/backward_start.h"
 #include "backend/odometry/bootstrap_refiner.h"
 #include "backend/odometry/frame_preparer.h"
 #include "backend/odometry/live_frame_source.h"
@@ -32,6 +33,7 @@
 #include "backend/odometry/two_view_bootstrap.h"
 #include "core/config_io.h"
 #include "core/evaluation.h"
+#include "core/frame_range_view.h"
 #include "core/statistics.h"
 #include "core/trajectory_io.h"
 #include "core/trajectory_svg.h"
@@ -145,7 +147,9 @@ class RunFiles {
 // Where the run starts: the config it runs with and frame 0's depth, from the bootstraps.
 struct InitialMap {
   OdometryConfig run_config;
-  cv::Mat depth;                // frame 0's z-depth (empty: the dataset's or a random map)
+  int first_frame = 0;          // the two-view start's anchor: the run proper starts there
+  BackwardStart backward;       // first_frame > 0: the frames before it
+  cv::Mat depth;                // first_frame's z-depth (empty: the dataset's or a random map)
   nlohmann::json bootstrap;     // summary.json `bootstrap` (null when not run)
   nlohmann::json two_view;      // summary.json `two_view_bootstrap` (null when not run)
   nlohmann::json random_start;  // summary.json `random_start` (null when not run)
@@ -155,7 +159,8 @@ struct InitialMap {
 // > 0 from the dataset's depth, otherwise odometry.two_view_bootstrap from the map of the two-view
 // geometry; a bootstrap that fails falls back to the random map, said so, whose initial values
 // odometry.random_start_candidates > 1 chooses among several.
-InitialMap PrepareInitialMap(const Dataset& dataset, const OdometryConfig& config, int num_frames) {
+InitialMap PrepareInitialMap(const Dataset& dataset, const OdometryConfig& config, int num_frames,
+                             bool realtime) {
   InitialMap initial;
   initial.run_config = config;
   initial.run_config.odometry.bootstrap_passes = 1;
@@ -179,29 +184,77 @@ InitialMap PrepareInitialMap(const Dataset& dataset, const OdometryConfig& confi
   CornerTracks unsettled_corners;
   if (config.odometry.two_view_bootstrap && config.odometry.bootstrap_passes <= 1 &&
       config.odometry.init_depth_idepth_var <= 0.0 && num_frames > 0) {
-    try {
-      const TwoViewBootstrap two_view =
-          BootstrapFromTwoViews(dataset, config, num_frames, &unsettled_corners);
-      initial.depth = two_view.depth;
-      initial.run_config.odometry.init_depth_idepth_var = config.odometry.bootstrap_idepth_var;
-      initial.two_view = {{"second_view", two_view.second_view},
-                          {"tracks", two_view.tracks},
-                          {"inliers", two_view.inliers},
-                          {"parallax_deg", two_view.parallax_deg},
-                          {"rotation_free_parallax_px", two_view.rotation_free_parallax_px},
-                          {"direction_std_deg", two_view.direction_std_deg},
-                          {"photometric_points", two_view.photometric_points},
-                          {"points", two_view.points},
-                          {"ms", two_view.ms}};
-      std::cerr << "pldvo run: two-view bootstrap: second view frame " << two_view.second_view
-                << ", " << two_view.inliers << " of " << two_view.tracks
-                << " corners triangulated, median parallax " << two_view.parallax_deg
-                << " deg, rotation-free " << two_view.rotation_free_parallax_px
-                << " px, direction std " << two_view.direction_std_deg << " deg, "
-                << two_view.photometric_points << " points refined photometrically, "
-                << two_view.points << " hypotheses, " << static_cast<int>(two_view.ms) << " ms\n";
-    } catch (const std::exception& e) {
-      std::cerr << "pldvo run: " << e.what() << "; the run starts from the random map\n";
+    // From frame 0, and where its corners are lost before a second view, again from the frame
+    // where they were lost (up to two_view_max_anchor; not live, where the frames before it have
+    // gone by).
+    const int max_anchor = realtime ? 0 : config.odometry.two_view_max_anchor;
+    int anchor = 0;
+    while (true) {
+      try {
+        const FrameRangeView from_anchor(dataset, anchor, FrameRangeView::Direction::kForward);
+        const TwoViewBootstrap two_view =
+            anchor == 0 ? BootstrapFromTwoViews(dataset, config, num_frames, &unsettled_corners)
+                        : BootstrapFromTwoViews(from_anchor, config, num_frames - anchor);
+        // The run's config from that map; the frames before a later anchor, backwards from it.
+        OdometryConfig run_config = initial.run_config;
+        run_config.odometry.init_depth_idepth_var = config.odometry.bootstrap_idepth_var;
+        BackwardStart backward;
+        if (anchor > 0) {
+          backward = TrackBackwardFromAnchor(dataset, run_config, anchor, two_view.depth);
+        }
+        initial.run_config = run_config;
+        initial.first_frame = anchor;
+        initial.depth = two_view.depth;
+        initial.backward = std::move(backward);
+        initial.two_view = {{"anchor", anchor},
+                            {"second_view", anchor + two_view.second_view},
+                            {"tracks", two_view.tracks},
+                            {"inliers", two_view.inliers},
+                            {"parallax_deg", two_view.parallax_deg},
+                            {"rotation_free_parallax_px", two_view.rotation_free_parallax_px},
+                            {"direction_std_deg", two_view.direction_std_deg},
+                            {"photometric_points", two_view.photometric_points},
+                            {"points", two_view.points},
+                            {"ms", two_view.ms}};
+        std::cerr << "pldvo run: two-view bootstrap: second view frame "
+                  << anchor + two_view.second_view << ", " << two_view.inliers << " of "
+                  << two_view.tracks << " corners triangulated, median parallax "
+                  << two_view.parallax_deg << " deg, rotation-free "
+                  << two_view.rotation_free_parallax_px << " px, direction std "
+                  << two_view.direction_std_deg << " deg, " << two_view.photometric_points
+                  << " points refined photometrically, " << two_view.points << " hypotheses, "
+                  << static_cast<int>(two_view.ms) << " ms\n";
+        if (anchor > 0) {
+          const OdometryStatistics& back = initial.backward.statistics;
+          initial.two_view["backward"] = {{"frames", anchor},
+                                          {"tracked", initial.backward.poses.size()},
+                                          {"keyframes", back.keyframes},
+                                          {"lost_events", back.lost_events},
+                                          {"scale_segments", back.scale_segments},
+                                          {"ms", initial.backward.ms}};
+          std::cerr << "pldvo run: frames 0-" << anchor - 1 << " tracked backwards from frame "
+                    << anchor << "'s map: " << initial.backward.poses.size() << " tracked, "
+                    << back.lost_events << " lost events, " << static_cast<int>(initial.backward.ms)
+                    << " ms\n";
+        }
+        break;
+      } catch (const std::exception& e) {
+        // A later start's frames are numbered from its anchor in the message.
+        const std::string where =
+            anchor > 0 ? "the start from frame " + std::to_string(anchor) + ": " : "";
+        const auto* failure = dynamic_cast<const TwoViewBootstrapFailure*>(&e);
+        // Frame `anchor` itself without enough corners: the next one.
+        const int next = failure != nullptr ? anchor + std::max(1, failure->tracks_lost_at) : 0;
+        if (failure == nullptr || failure->tracks_lost_at < 0 || next > max_anchor ||
+            num_frames - next < 2) {
+          std::cerr << "pldvo run: " << where << e.what()
+                    << "; the run starts from the random map\n";
+          break;
+        }
+        std::cerr << "pldvo run: " << where << e.what() << "; starting again from frame " << next
+                  << "\n";
+        anchor = next;
+      }
     }
   }
   if (initial.depth.empty() && initial.run_config.odometry.init_depth_idepth_var <= 0.0 &&
@@ -226,7 +279,7 @@ InitialMap PrepareInitialMap(const Dataset& dataset, const OdometryConfig& confi
                               {"ms", choice.ms}};
       std::cerr << "pldvo run: random start: mapping.init_seed " << choice.init_seed << " of "
                 << choice.candidates.size() << " initial maps fits frames 1-" << choice.frames - 1
-                << (choice.by_corners ? " and frame 0's tracked corners" : "") << " best, "
+                << (choice.by_corners ? " and the tracked corners" : "") << " best, "
                 << static_cast<int>(choice.ms) << " ms\n";
     } catch (const std::exception& e) {
       std::cerr << "pldvo run: random start choice failed (" << e.what()
@@ -236,14 +289,14 @@ InitialMap PrepareInitialMap(const Dataset& dataset, const OdometryConfig& confi
   return initial;
 }
 
-// The offline feed: every frame in order, frame i + 1 loaded (and prepared) on another thread
-// while frame i is processed. One task runs at a time, so the preparer is never used by two
-// threads at once.
+// The offline feed: every frame from `first` on in order, frame i + 1 loaded (and prepared) on
+// another thread while frame i is processed. One task runs at a time, so the preparer is never
+// used by two threads at once.
 class PrefetchingFrameSource {
  public:
-  PrefetchingFrameSource(const Dataset& dataset, int num_frames, FramePreparer* preparer)
-      : dataset_(dataset), num_frames_(num_frames), preparer_(preparer) {
-    if (num_frames_ > 0) next_ = Load(0);
+  PrefetchingFrameSource(const Dataset& dataset, int num_frames, FramePreparer* preparer, int first)
+      : dataset_(dataset), num_frames_(num_frames), preparer_(preparer), index_(first) {
+    if (index_ < num_frames_) next_ = Load(index_);
   }
   std::optional<std::pair<int, LoadedFrame>> Next() {
     if (index_ >= num_frames_) return std::nullopt;
@@ -260,7 +313,7 @@ class PrefetchingFrameSource {
   const Dataset& dataset_;
   const int num_frames_;
   FramePreparer* preparer_;
-  int index_ = 0;
+  int index_;
   std::future<LoadedFrame> next_;
 };
 
@@ -289,7 +342,7 @@ OdometryFrameResult ProcessLoadedFrame(const Dataset& dataset, const InitialMap&
   }
   try {
     cv::Mat depth;
-    if (i == 0 && !initial.depth.empty()) {
+    if (i == initial.first_frame && !initial.depth.empty()) {
       depth = initial.depth;
     } else if (i == 0 && config.odometry.init_depth_idepth_var > 0.0) {
       depth = dataset.LoadDepth(i);
@@ -433,7 +486,7 @@ SequenceRunResult SequenceRunner::Run() {
 
   const int num_frames =
       options_.max_frames > 0 ? std::min(options_.max_frames, dataset_.size()) : dataset_.size();
-  const InitialMap initial = PrepareInitialMap(dataset_, config_, num_frames);
+  const InitialMap initial = PrepareInitialMap(dataset_, config_, num_frames, options_.realtime);
   Odometry odometry(dataset_.camera(), initial.run_config, observer_);
 
   std::unique_ptr<SolverComparison> comparison;
@@ -456,7 +509,15 @@ SequenceRunResult SequenceRunner::Run() {
   if (initial.run_config.odometry.frontend_thread) {
     preparer = std::make_unique<FramePreparer>(initial.run_config);
   }
-  PrefetchingFrameSource offline(dataset_, options_.realtime ? 0 : num_frames, preparer.get());
+  PrefetchingFrameSource offline(dataset_, options_.realtime ? 0 : num_frames, preparer.get(),
+                                 initial.first_frame);
+  // A re-anchored two-view start: the frames before it, tracked backwards (no keyframe of the run
+  // proper: trajectory_ba.txt leaves them out).
+  for (const StampedPose& pose : initial.backward.poses) {
+    files.AddPose(pose);
+    estimate.push_back(pose);
+    anchors.push_back({-1, SE3()});
+  }
   LiveFrameSource<LoadedFrame> live(dataset_, options_.realtime ? num_frames : 0, [&](int index) {
     return LoadFrame(dataset_, index, preparer.get());
   });
@@ -501,23 +562,31 @@ SequenceRunResult SequenceRunner::Run() {
   const double run_seconds = std::chrono::duration<double>(WallClock::now() - run_start).count();
   const OdometryStatistics stats = odometry.statistics();
 
+  // The frames before a re-anchored start count as tracked or lost where the backward pass left
+  // them (its anchor frame is the run's first), its re-initialisations as scale segments.
+  const OdometryStatistics& back = initial.backward.statistics;
+  const int tracked = stats.tracked + static_cast<int>(initial.backward.poses.size());
+  const int lost_events = stats.lost_events + back.lost_events;
+  const int lost_frames = stats.lost_frames + back.lost_frames;
+  const int scale_segments = stats.scale_segments + std::max(0, back.scale_segments - 1);
+
   SequenceRunResult result;
   result.frames = num_frames;
-  result.tracked = stats.tracked;
+  result.tracked = tracked;
   result.failed = failed;
   nlohmann::json& summary = result.summary;
   summary["dataset"] = options_.dataset_label;
   summary["config"] = options_.config_label;
   summary["frames"] = num_frames;
-  summary["tracked"] = stats.tracked;
+  summary["tracked"] = tracked;
   summary["keyframes"] = stats.keyframes;
-  summary["lost_events"] = stats.lost_events;
-  summary["lost_frames"] = stats.lost_frames;
+  summary["lost_events"] = lost_events;
+  summary["lost_frames"] = lost_frames;
   summary["failed_frames"] = failed;
   summary["reinitializations"] = stats.reinitializations;
   // Pieces of the trajectory with one scale: a re-initialisation with a fresh random map starts
   // a new one (OdometryStatistics::scale_segments).
-  summary["scale_segments"] = stats.scale_segments;
+  summary["scale_segments"] = scale_segments;
   summary["line_term_drops"] = stats.line_term_drops;
   summary["line_term_withheld"] = stats.line_term_withheld;
   summary["alternatives_gated"] = stats.alternatives_gated;
@@ -538,7 +607,8 @@ SequenceRunResult SequenceRunner::Run() {
   summary["two_view_bootstrap"] = initial.two_view;
   // odometry.random_start_candidates: the initial maps tried and the one the run started from.
   summary["random_start"] = initial.random_start;
-  summary["fps"] = run_seconds > 0.0 ? num_frames / run_seconds : 0.0;
+  // The run proper's frames (from a re-anchored start's anchor on) per second.
+  summary["fps"] = run_seconds > 0.0 ? (num_frames - initial.first_frame) / run_seconds : 0.0;
   // Edge bundle adjustment (backend.edge_ba): windows solved, applied, CPU ms per window, and
   // the line-depth feedback (backend.edge_ba.line_depth_feedback, docs/edge_ba.md).
   summary["edge_ba_windows"] = stats.edge_ba_windows;
@@ -620,9 +690,9 @@ SequenceRunResult SequenceRunner::Run() {
   AddTimingSummary(rows, odometry.MappingJobTimesMs(), &summary);
 
   std::ostringstream header;
-  header << num_frames << " frames, " << stats.tracked << " tracked, " << stats.keyframes
-         << " keyframes, " << stats.lost_events << " lost events (" << stats.lost_frames
-         << " frames), " << failed << " failed to load; " << std::fixed << std::setprecision(1)
+  header << num_frames << " frames, " << tracked << " tracked, " << stats.keyframes
+         << " keyframes, " << lost_events << " lost events (" << lost_frames << " frames), "
+         << failed << " failed to load; " << std::fixed << std::setprecision(1)
          << summary["fps"].get<double>() << " frames/s";
   result.report.push_back(header.str());
   result.report.push_back("  component        median ms   mean ms");

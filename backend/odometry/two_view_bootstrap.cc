@@ -63,9 +63,10 @@ cv::Mat ToGray8(const cv::Mat& image) {
   return gray;
 }
 
-// One corner of frame 0 followed through the frames: its position in every frame so far.
+// One corner followed through the frames from its anchor: its position in every frame so far.
 struct Track {
   std::vector<cv::Point2f> positions;
+  int anchor = 0;  // the frame of positions[0]
 };
 
 // The live tracks' positions in `next` (forward-backward checked; ok[i] says which survived).
@@ -367,12 +368,41 @@ int RefinePhotometrically(const std::vector<cv::Mat>& images, const SemiDenseDep
   return static_cast<int>(result.points.size());
 }
 
+// Where frame 0's corners are lost before the random start's horizon: from the frame they were
+// lost in (`previous`, its gray image), corners detected there are followed on, and again wherever
+// the newest anchor's corners fall below two_view_min_inliers, up to frame horizon - 1. Every
+// track, frame 0's included, goes to `out` with its anchor.
+void TrackReanchoredCorners(const Dataset& dataset, const OdometryOptions& options, int lost_at,
+                            int horizon, cv::Mat previous, std::vector<Track> tracks,
+                            std::vector<Track> lost, CornerTracks* out) {
+  int anchor = 0;
+  for (int k = lost_at; k < horizon; ++k) {
+    if (k > lost_at) previous = TrackInto(previous, dataset.Load(k).image, &tracks, &lost);
+    const int alive = static_cast<int>(std::count_if(
+        tracks.begin(), tracks.end(), [&](const Track& t) { return t.anchor == anchor; }));
+    if (alive >= options.two_view_min_inliers || k + 1 >= horizon) continue;
+    std::vector<cv::Point2f> corners;
+    cv::goodFeaturesToTrack(previous, corners, kMaxCorners, options.two_view_corner_quality,
+                            options.two_view_corner_min_distance_px);
+    anchor = k;
+    for (const cv::Point2f& corner : corners) tracks.push_back({{corner}, anchor});
+  }
+  out->positions.clear();
+  out->anchors.clear();
+  for (std::vector<Track>* set : {&lost, &tracks}) {
+    for (Track& track : *set) {
+      out->positions.push_back(std::move(track.positions));
+      out->anchors.push_back(track.anchor);
+    }
+  }
+}
+
 TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryConfig& config,
                                        int num_frames, CornerTracks* unsettled_tracks) {
   const auto start = WallClock::now();
   const OdometryOptions& options = config.odometry;
   const int last = std::min(num_frames, options.two_view_max_frames + 1);
-  if (last < 2) throw std::runtime_error("two-view bootstrap: fewer than two frames");
+  if (last < 2) throw TwoViewBootstrapFailure("two-view bootstrap: fewer than two frames", -1);
   const PinholeCamera& camera = dataset.camera();
   const cv::Matx33d K(camera.fx, 0.0, camera.cx, 0.0, camera.fy, camera.cy, 0.0, 0.0, 1.0);
 
@@ -382,8 +412,10 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
   cv::goodFeaturesToTrack(previous, corners, kMaxCorners, options.two_view_corner_quality,
                           options.two_view_corner_min_distance_px);
   if (static_cast<int>(corners.size()) < options.two_view_min_inliers) {
-    throw std::runtime_error("two-view bootstrap: frame 0 has " + std::to_string(corners.size()) +
-                             " corners, fewer than two_view_min_inliers");
+    throw TwoViewBootstrapFailure("two-view bootstrap: frame 0 has " +
+                                      std::to_string(corners.size()) +
+                                      " corners, fewer than two_view_min_inliers",
+                                  0);
   }
   std::vector<Track> tracks, lost;
   for (const cv::Point2f& corner : corners) tracks.push_back({{corner}});
@@ -474,6 +506,7 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
     if (tested > 0 && (!lost_tracks || tracks_lost_at >= options.random_start_frames)) {
       if (unsettled_tracks != nullptr) {
         unsettled_tracks->positions.clear();
+        unsettled_tracks->anchors.clear();
         for (std::vector<Track>* set : {&lost, &tracks}) {
           for (Track& track : *set) {
             unsettled_tracks->positions.push_back(std::move(track.positions));
@@ -487,7 +520,16 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
             std::to_string(options.two_view_stable_frames) +
             " last frames' directions agreeing to it";
     }
-    throw std::runtime_error("two-view bootstrap: " + why);
+    // Lost before the random start's horizon: corners detected later check its later frames.
+    const int horizon = std::min(num_frames, options.random_start_frames);
+    if (options.random_start_reanchored_corners && unsettled_tracks != nullptr && lost_tracks &&
+        tracks_lost_at < horizon) {
+      TrackReanchoredCorners(dataset, options, tracks_lost_at, horizon, previous, std::move(tracks),
+                             std::move(lost), unsettled_tracks);
+      why += "; corners detected again from frame " + std::to_string(tracks_lost_at) +
+             " check the random start";
+    }
+    throw TwoViewBootstrapFailure("two-view bootstrap: " + why, tracks_lost_at);
   }
   result.tracks = static_cast<int>(tracks.size());
   result.inliers = static_cast<int>(geometry.points.size());
@@ -508,7 +550,8 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
     if (X.z() > 0.0) idepths.push_back(1.0 / X.z());
   }
   if (idepths.empty()) {
-    throw std::runtime_error("two-view bootstrap: no corner in front after the adjustment");
+    throw TwoViewBootstrapFailure("two-view bootstrap: no corner in front after the adjustment",
+                                  -1);
   }
   const double scale = Median(idepths);
 
@@ -543,7 +586,8 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
   double median_idepth = 0.0;  // of the map: `depth` is in units of 1 / median_idepth
   result.depth = NormalizedObservedDepth(mapper->depth_map(), &result.points, &median_idepth);
   if (result.depth.empty()) {
-    throw std::runtime_error("two-view bootstrap: frame 0's map has no observed hypothesis");
+    throw TwoViewBootstrapFailure("two-view bootstrap: frame 0's map has no observed hypothesis",
+                                  -1);
   }
   result.second_from_first = SE3(poses[k].rotation(), poses[k].translation() * median_idepth);
   result.ms = MsSince(start);

@@ -38,6 +38,8 @@
 #define PLDVO_BACKEND_ODOMETRY_TWO_VIEW_BOOTSTRAP_H_
 
 #include <opencv2/core.hpp>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "backend/odometry/corner_epipolar_error.h"
@@ -63,6 +65,16 @@ struct TwoViewBootstrap {
   double ms = 0.0;                 // wall time
 };
 
+// Why a two-view start failed; tracks_lost_at is the frame where fewer than two_view_min_inliers
+// corners were left (0: frame 0 has fewer; -1 when the start failed otherwise): a later anchor
+// may start there.
+class TwoViewBootstrapFailure : public std::runtime_error {
+ public:
+  TwoViewBootstrapFailure(const std::string& what, int tracks_lost_at)
+      : std::runtime_error(what), tracks_lost_at(tracks_lost_at) {}
+  int tracks_lost_at;
+};
+
 // The parallax of the matched pixels x0[i] <-> xk[i] that no rotation explains, px: the median
 // angle between the rays of xk and the rays of x0 turned by the rotation that best aligns them
 // (Kabsch on unit rays), times the focal length sqrt(fx fy). Pure rotation gives 0 whatever the
@@ -75,12 +87,14 @@ double RotationFreeParallaxPx(const std::vector<cv::Point2f>& x0,
                               const std::vector<cv::Point2f>& xk, const cv::Matx33d& K);
 
 // Runs the two-view bootstrap over the first min(num_frames, two_view_max_frames) frames of
-// `dataset` with config.mapping. Throws std::runtime_error, saying why, when frame 0 cannot be
+// `dataset` with config.mapping. Throws TwoViewBootstrapFailure, saying why, when frame 0 cannot be
 // loaded or has too few corners, when the tracks are lost, when no frame reaches the parallax,
 // when no frame passes the direction gate (then, and when the tracks are lost after a frame
-// passed the parallax gates, *unsettled_tracks, if given, gets every corner's track, lost ones
-// included: they fix the direction roughly, corner_epipolar_error.h), or when the map ends
-// without observed hypotheses.
+// passed the parallax gates after odometry.random_start_frames, *unsettled_tracks, if given,
+// gets every corner's track, lost ones included: they fix the direction roughly,
+// corner_epipolar_error.h; with odometry.random_start_reanchored_corners, tracks lost before
+// that horizon go too, with corners detected again where they were lost, up to the horizon), or
+// when the map ends without observed hypotheses.
 TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryConfig& config,
                                        int num_frames, CornerTracks* unsettled_tracks = nullptr);
 

@@ -140,5 +140,41 @@ TEST(CornerEpipolarErrorTest, FramesWithoutEnoughCornersOrMotionDoNotCount) {
   EXPECT_TRUE(std::isnan(CornerEpipolarErrorPx(short_tracks, {}, Camera())));
 }
 
+TEST(CornerEpipolarErrorTest, ReanchoredTracksCheckTheFramesAfterFrameZerosCornersAreLost) {
+  // Frame 0's corners are lost after frame 20 and corners detected in frame 20 take over. A start
+  // that follows the truth to frame 20 and then moves 20 deg off its direction fits frame 0's
+  // corners exactly as the truth does; frame 20's corners tell them apart.
+  constexpr int kAnchor = 20;
+  const std::vector<SE3> poses = Motion(60, Eigen::Vector3d(0.01, 0.0, 0.005));
+  const std::vector<SE3> later(poses.begin() + kAnchor, poses.end());
+  std::vector<SE3> wrong(poses.begin(), poses.begin() + kAnchor);
+  for (const SE3& pose : TurnDirection(later, 20.0)) wrong.push_back(pose);
+
+  CornerTracks tracks = Project(poses, 0.5, 300, /*lose_after=*/kAnchor);
+  const double frame_0_truth = CornerEpipolarErrorPx(tracks, poses, Camera());
+  EXPECT_DOUBLE_EQ(CornerEpipolarErrorPx(tracks, wrong, Camera()), frame_0_truth);
+
+  tracks.anchors.assign(tracks.positions.size(), 0);
+  const CornerTracks from_anchor = Project(later, 0.5, 300);
+  for (const std::vector<cv::Point2f>& track : from_anchor.positions) {
+    tracks.positions.push_back(track);
+    tracks.anchors.push_back(kAnchor);
+  }
+  const double truth = CornerEpipolarErrorPx(tracks, poses, Camera());
+  const double off = CornerEpipolarErrorPx(tracks, wrong, Camera());
+  std::printf("re-anchored at frame %d: truth %.3f px, 20 deg off after it %.3f px\n", kAnchor,
+              truth, off);
+  EXPECT_NEAR(truth, 0.6745 * 0.5, 0.05);
+  EXPECT_GT(off, 3.0 * truth);
+  // The anchor's frames are measured from the anchor: the truth shifted by any pose before it
+  // (here the first 20 frames replaced by the identity) fits them alike.
+  std::vector<SE3> other_start(kAnchor, SE3());
+  other_start.insert(other_start.end(), later.begin(), later.end());
+  CornerTracks anchor_only = from_anchor;
+  anchor_only.anchors.assign(anchor_only.positions.size(), kAnchor);
+  EXPECT_NEAR(CornerEpipolarErrorPx(anchor_only, other_start, Camera()),
+              CornerEpipolarErrorPx(anchor_only, poses, Camera()), 1e-9);
+}
+
 }  // namespace
 }  // namespace pldvo

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -412,6 +413,50 @@ TEST(TwoViewBootstrapTest, CornersLostAfterTheParallaxGatesCheckTheRandomStartOv
   const std::string lost_early = run(kLowtexFrames + 1, &too_short);
   EXPECT_NE(lost_early.find("corners left at frame 12"), std::string::npos) << lost_early;
   EXPECT_TRUE(too_short.positions.empty());
+}
+
+// Frame 0's corners lost early (a blank frame 6 loses every track, the next frames are the
+// render's again): with random_start_reanchored_corners, corners detected again where the newest
+// anchor's were lost (the blank frame has none, so frame 7) check the random start's later frames;
+// without it, none go.
+TEST(TwoViewBootstrapTest, CornersLostEarlyAreDetectedAgainForTheRandomStart) {
+  constexpr int kFramesRun = 21, kBlank = 6;
+  const synthetic::SynthOptions options = test::SmallLowtexOptions(150);
+  const synthetic::SyntheticSequence sequence = synthetic::MakeSequence(options);
+  std::vector<cv::Mat> images = NearRotationFrames(sequence, kFramesRun);
+  images.push_back(cv::Mat(images[0].size(), CV_32F, cv::Scalar(128.0f)));
+  std::vector<int> frames(kFramesRun);
+  std::iota(frames.begin(), frames.end(), 0);
+  frames[kBlank] = kFramesRun;
+  const RenderedDataset dataset(sequence, images, frames);
+  OdometryConfig config;
+  config.odometry.random_start_frames = kFramesRun;
+
+  CornerTracks none;
+  const std::string why = Outcome(dataset, config, kFramesRun, &none);
+  EXPECT_NE(why.find("corners left at frame 6"), std::string::npos) << why;
+  EXPECT_TRUE(none.positions.empty());
+
+  config.odometry.random_start_reanchored_corners = true;
+  CornerTracks reanchored;
+  const std::string again = Outcome(dataset, config, kFramesRun, &reanchored);
+  EXPECT_NE(again.find("corners detected again from frame 6"), std::string::npos) << again;
+  ASSERT_EQ(reanchored.anchors.size(), reanchored.positions.size());
+  std::map<int, int> alive_at_end;  // per anchor, the tracks that reach the last frame
+  for (size_t i = 0; i < reanchored.positions.size(); ++i) {
+    const int anchor = reanchored.Anchor(i);
+    ASSERT_TRUE(anchor == 0 || anchor == kBlank + 1) << anchor;
+    const int last = anchor + static_cast<int>(reanchored.positions[i].size()) - 1;
+    ASSERT_LE(last, anchor == 0 ? kBlank - 1 : kFramesRun - 1);
+    alive_at_end[anchor] += last == kFramesRun - 1;
+  }
+  EXPECT_GE(alive_at_end[kBlank + 1], config.odometry.two_view_min_inliers);
+  // The ground-truth motion fits them to the tracking's accuracy, over both anchors.
+  std::vector<SE3> truth;
+  for (int k = 0; k < kFramesRun; ++k) truth.push_back(sequence.ground_truth[k].world_from_cam);
+  const double truth_px = CornerEpipolarErrorPx(reanchored, truth, dataset.camera());
+  std::printf("re-anchored corners' epipolar error against the ground truth: %.3f px\n", truth_px);
+  EXPECT_LT(truth_px, 0.5);
 }
 
 // An auto-exposure camera: frame k's intensities scaled by a gain that swings +-30% about 1 and
