@@ -517,6 +517,10 @@ SequenceRunResult SequenceRunner::Run() {
     files.AddPose(pose);
     estimate.push_back(pose);
     anchors.push_back({-1, SE3()});
+    if (comparison != nullptr && !comparison->AddUncompared(pose)) {
+      throw RunOutputError("cannot write " + out +
+                           "/trajectory_compare.txt: " + std::strerror(errno) + "; stopping");
+    }
   }
   LiveFrameSource<LoadedFrame> live(dataset_, options_.realtime ? num_frames : 0, [&](int index) {
     return LoadFrame(dataset_, index, preparer.get());

@@ -44,7 +44,11 @@ bool SolverComparison::Add(const OdometryFrameResult& result) {
     compare_tracking_ms_.push_back(result.timing.compare_tracking_ms);
     lost_ += result.compared_status == TrackingStatus::kLost;
   }
-  trajectory_.push_back({result.timestamp, pose});
+  return AddUncompared({result.timestamp, pose});
+}
+
+bool SolverComparison::AddUncompared(const StampedPose& pose) {
+  trajectory_.push_back(pose);
   WriteTumLine(trajectory_.back(), file_);
   return static_cast<bool>(file_.flush());
 }

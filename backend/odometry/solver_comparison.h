@@ -27,6 +27,9 @@ class SolverComparison {
   // when the frame was compared, else with the run's pose (the first frame, re-initialisations).
   // False when the write failed.
   bool Add(const OdometryFrameResult& result);
+  // A tracked frame the other solver did not see (before a re-anchored two-view start,
+  // backward_start.h): the run's pose, as for the first frame. False when the write failed.
+  bool AddUncompared(const StampedPose& pose);
 
   // The summary.json object: solver, frames compared, frames the other solver lost, median and
   // max translation (m) and rotation (deg) differences, median ms of one tracking solve (the

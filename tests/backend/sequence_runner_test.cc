@@ -159,6 +159,7 @@ TEST(SequenceRunnerTest, TwoViewStartReanchoredAfterItsCornersAreLost) {
   options.dataset_label = folder.string();
   OdometryConfig config = DeterministicConfig();
   config.odometry.two_view_max_anchor = 10;
+  config.odometry.compare_solver = OdometryOptions::CompareSolver::kCeres;
   SequenceRunner runner(dataset, config, options);
   const SequenceRunResult result = runner.Run();
 
@@ -178,6 +179,16 @@ TEST(SequenceRunnerTest, TwoViewStartReanchoredAfterItsCornersAreLost) {
   EXPECT_TRUE(estimate[2].world_from_cam.translation().isZero());  // the anchor is the world
   // Frames 0-1 and 3-35 in one scale: the Sim(3)-aligned trajectory follows the ground truth
   // to a fraction of the 1.2 s path (about 0.3 m at this render's speed).
+  // The solver comparison's trajectory has the same frames: those before the anchor as the run's.
+  const Trajectory compared = ReadTrajectoryTum(options.out_dir + "/trajectory_compare.txt");
+  ASSERT_EQ(compared.size(), estimate.size());
+  const int compared_frames = result.summary["compare_solver"]["frames_compared"].get<int>();
+  EXPECT_GT(compared_frames, 0);
+  EXPECT_LE(compared_frames, kFrames - 4);  // not frames 0-3
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_TRUE(compared[i].world_from_cam.translation().isApprox(
+        estimate[i].world_from_cam.translation()));
+  }
   const EvaluationResult eval = EvaluateTrajectory(*dataset.ground_truth(), estimate);
   std::printf("re-anchored at frame 3: ATE %.4f m, RPE %.3f cm/s\n", eval.ate_m, eval.rpe_cm_s);
   EXPECT_LT(eval.ate_m, 0.005);
