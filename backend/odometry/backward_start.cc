@@ -27,18 +27,8 @@ BackwardStart TrackBackwardFromAnchor(const Dataset& dataset, const OdometryConf
   Odometry odometry(dataset.camera(), config);
   BackwardStart result;
   for (int i = 0; i < backwards.size(); ++i) {
-    const LoadedFrame loaded = LoadFrame(backwards, i);
-    OdometryFrameResult frame;
-    if (!loaded.error.empty()) {
-      frame = odometry.SkipFrame(i, backwards.timestamp(i), loaded.error);
-    } else {
-      try {
-        frame = odometry.ProcessFrame(i, loaded.frame.timestamp, loaded.frame.image,
-                                      i == 0 ? anchor_depth : cv::Mat());
-      } catch (const std::exception& e) {
-        frame = odometry.SkipFrame(i, loaded.frame.timestamp, e.what());
-      }
-    }
+    const OdometryFrameResult frame = ProcessOrSkip(backwards, i, LoadFrame(backwards, i),
+                                                    &odometry, i == 0 ? anchor_depth : cv::Mat());
     if (i > 0 && IsTracked(frame.status)) {
       result.poses.push_back({dataset.timestamp(backwards.DatasetIndex(i)), frame.world_from_cam});
     }

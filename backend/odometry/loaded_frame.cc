@@ -29,4 +29,15 @@ LoadedFrame LoadFrame(const Dataset& dataset, int index, FramePreparer* preparer
   return loaded;
 }
 
+OdometryFrameResult ProcessOrSkip(const Dataset& dataset, int index, const LoadedFrame& loaded,
+                                  Odometry* odometry, const cv::Mat& depth) {
+  if (!loaded.error.empty())
+    return odometry->SkipFrame(index, dataset.timestamp(index), loaded.error);
+  try {
+    return odometry->ProcessFrame(index, loaded.frame.timestamp, loaded.frame.image, depth);
+  } catch (const std::exception& e) {
+    return odometry->SkipFrame(index, loaded.frame.timestamp, e.what());
+  }
+}
+
 }  // namespace pldvo

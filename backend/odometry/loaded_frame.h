@@ -7,6 +7,7 @@
 #include <string>
 
 #include "backend/odometry/frame_preparer.h"
+#include "backend/odometry/odometry.h"
 #include "core/dataset.h"
 
 namespace pldvo {
@@ -22,6 +23,12 @@ struct LoadedFrame {
 // Loads frame `index` and, with a `preparer`, prepares it on the same (loading) thread. A frame
 // that is not a gray image of the camera's size is left unprepared: ProcessFrame reports it.
 LoadedFrame LoadFrame(const Dataset& dataset, int index, FramePreparer* preparer = nullptr);
+
+// `loaded` (frame `index` of `dataset`) through `odometry`, quietly (the starts' own runs): a frame
+// that failed to load or throws inside is skipped, as in the run (sequence_runner.cc). `depth` as
+// Odometry::ProcessFrame's.
+OdometryFrameResult ProcessOrSkip(const Dataset& dataset, int index, const LoadedFrame& loaded,
+                                  Odometry* odometry, const cv::Mat& depth = cv::Mat());
 
 }  // namespace pldvo
 

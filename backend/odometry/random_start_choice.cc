@@ -48,18 +48,7 @@ RandomStartChoice ChooseRandomStart(const Dataset& dataset, const OdometryConfig
     int tracked = 0;
     std::vector<SE3> world_from_cam;
     for (int i = 0; i < choice.frames; ++i) {
-      // A frame that fails to load or to process is skipped, as in the run (sequence_runner.cc).
-      const LoadedFrame& loaded = frames[i];
-      OdometryFrameResult result;
-      if (!loaded.error.empty()) {
-        result = odometry.SkipFrame(i, dataset.timestamp(i), loaded.error);
-      } else {
-        try {
-          result = odometry.ProcessFrame(i, loaded.frame.timestamp, loaded.frame.image);
-        } catch (const std::exception& e) {
-          result = odometry.SkipFrame(i, loaded.frame.timestamp, e.what());
-        }
-      }
+      const OdometryFrameResult result = ProcessOrSkip(dataset, i, frames[i], &odometry);
       world_from_cam.push_back(result.world_from_cam);
       if (i == 0) continue;  // the keyframe itself
       if (IsTracked(result.status)) {
