@@ -197,8 +197,9 @@ struct OdometryOptions {
   // Where the corners are lost (fewer than two_view_min_inliers) before a second view, the start
   // begins again at the frame where they were lost, as long as that frame is at most
   // two_view_max_anchor; the frames before it are tracked backwards from its map
-  // (backward_start.h). 0: frame 0 only.
-  int two_view_max_anchor = 90;
+  // (backward_start.h). 0: frame 0 only. 300 bounds the start-up delay (about 17 s of backward
+  // tracking at 640x480); measured against 90 in docs/bootstrap.md.
+  int two_view_max_anchor = 300;
   // Its corners: cv::goodFeaturesToTrack's quality (relative to the strongest corner) and spacing;
   // the second view's adjusted translation direction: its largest standard deviation, and how
   // many consecutive frames' directions must agree to within that.
@@ -325,7 +326,7 @@ struct OdometryOptions {
     v.Field("two_view_max_anchor", &two_view_max_anchor,
             "Two-view bootstrap: where the corners are lost before a second view, the start "
             "begins again at the frame where they were lost, up to this frame; the frames before "
-            "are tracked backwards from its map (0: frame 0 only; default 90).");
+            "are tracked backwards from its map (0: frame 0 only; default 300).");
     v.Field("two_view_corner_quality", &two_view_corner_quality,
             "Two-view bootstrap: smallest corner response relative to frame 0's strongest "
             "(cv::goodFeaturesToTrack qualityLevel, default 0.001).");
