@@ -90,7 +90,8 @@ Odometry::Odometry(const PinholeCamera& camera, const OdometryConfig& config,
   }
   const WindowedBAOptions& windowed_ba = config_.backend.windowed_ba;
   if (windowed_ba.enabled) {
-    windowed_ba_keyframes_ = std::make_unique<WindowedBAKeyframes>(camera_, windowed_ba.window);
+    windowed_ba_keyframes_ = std::make_unique<WindowedBAKeyframes>(
+        camera_, windowed_ba.window, windowed_ba.leaving, windowed_ba.leaving_min_visible);
     if (config_.odometry.parallel_mapping) {
       windowed_ba_adjuster_ = std::make_unique<WindowedBundleAdjuster>(windowed_ba);
     }
@@ -343,6 +344,10 @@ std::vector<KeyframePoseRecord> Odometry::WindowedBAKeyframePoses() const {
   std::vector<KeyframePoseRecord> poses = windowed_ba_keyframes_->Departed();
   const std::vector<KeyframePoseRecord> recorded = windowed_ba_keyframes_->Recorded();
   poses.insert(poses.end(), recorded.begin(), recorded.end());
+  // Keyframes may leave out of order (backend.windowed_ba.leaving); the output is in time order.
+  std::stable_sort(
+      poses.begin(), poses.end(),
+      [](const KeyframePoseRecord& a, const KeyframePoseRecord& b) { return a.id < b.id; });
   return poses;
 }
 

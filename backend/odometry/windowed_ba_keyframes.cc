@@ -1,5 +1,6 @@
 #include "backend/odometry/windowed_ba_keyframes.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
@@ -18,8 +19,9 @@ AffineBrightness Rebase(const AffineBrightness& brightness, const AffineBrightne
 
 }  // namespace
 
-WindowedBAKeyframes::WindowedBAKeyframes(const PinholeCamera& camera, int size)
-    : camera_(camera), size_(size) {
+WindowedBAKeyframes::WindowedBAKeyframes(const PinholeCamera& camera, int size,
+                                         LeavingKeyframe leaving, double min_visible)
+    : camera_(camera), size_(size), leaving_(leaving), min_visible_(min_visible) {
   if (size_ < 2) throw std::invalid_argument("WindowedBAKeyframes: size must be >= 2");
 }
 
@@ -56,9 +58,35 @@ void WindowedBAKeyframes::AddKeyframe(int id, int frame_index, double timestamp,
   }
   keyframes_.push_back(std::move(keyframe));
   while (static_cast<int>(keyframes_.size()) > size_) {
-    departed_.push_back(keyframes_.front().record);
-    keyframes_.pop_front();
+    std::vector<LeavingCandidate> candidates(keyframes_.size());
+    for (size_t k = 0; k < keyframes_.size(); ++k) {
+      candidates[k].centre = keyframes_[k].record.world_from_kf.translation();
+      if (leaving_ == LeavingKeyframe::kSpread && k + 2 < keyframes_.size()) {
+        candidates[k].visible_in_newest = VisibleInNewest(keyframes_[k]);
+      }
+    }
+    // The newest two stay: the previous keyframe's final map is still to come (SetPoints).
+    const int leaving = ChooseLeavingKeyframe(candidates, leaving_, 2, min_visible_);
+    departed_.push_back(keyframes_[leaving].record);
+    keyframes_.erase(keyframes_.begin() + leaving);
   }
+}
+
+double WindowedBAKeyframes::VisibleInNewest(const Keyframe& keyframe) const {
+  if (keyframe.points == nullptr || keyframe.points->empty()) return -1.0;
+  const SE3 newest_from_kf =
+      keyframes_.back().record.world_from_kf.Inverse() * keyframe.record.world_from_kf;
+  const std::vector<WindowedBAPoint>& points = *keyframe.points;
+  const size_t step = std::max<size_t>(1, points.size() / 2000);
+  int seen = 0;
+  int tried = 0;
+  for (size_t i = 0; i < points.size(); i += step) {
+    ++tried;
+    const Eigen::Vector3d in_newest =
+        newest_from_kf * (camera_.Unproject(points[i].pixel) / points[i].idepth);
+    seen += in_newest.z() > 0.0 && camera_.IsInside(camera_.Project(in_newest), 0.0);
+  }
+  return static_cast<double>(seen) / tried;
 }
 
 void WindowedBAKeyframes::Clear() {

@@ -28,6 +28,7 @@
 
 #include "backend/mapping/depth_mapper.h"
 #include "backend/mapping/semi_dense_depth_map.h"
+#include "backend/windowed_ba/leaving_keyframe.h"
 #include "backend/windowed_ba/windowed_ba_solver.h"
 #include "backend/windowed_ba/windowed_ba_window.h"
 #include "core/pinhole_camera.h"
@@ -53,14 +54,17 @@ std::vector<WindowedBAPoint> ObservedWindowPoints(const SemiDenseDepthMap& map);
 
 class WindowedBAKeyframes {
  public:
-  // Keeps the newest `size` keyframes (>= 2). Throws std::invalid_argument otherwise.
-  WindowedBAKeyframes(const PinholeCamera& camera, int size);
+  // Keeps `size` keyframes (>= 2; throws std::invalid_argument otherwise): the newest, or with
+  // LeavingKeyframe::kSpread the newest two and those DSO's choice keeps (leaving_keyframe.h).
+  WindowedBAKeyframes(const PinholeCamera& camera, int size,
+                      LeavingKeyframe leaving = LeavingKeyframe::kOldest,
+                      double min_visible = 0.05);
 
   // Appends a keyframe (id larger than every recorded one) without points (SetPoints).
   // previous_segment[j]: the previous recorded keyframe's segment matched to segment j, or -1
   // (may be shorter; missing entries are -1). brightness_from_previous: its image relative to the
-  // previous keyframe's (I = e^a I_prev + b). The oldest keyframe leaves when the window is full
-  // (its record moves to Departed()).
+  // previous keyframe's (I = e^a I_prev + b). When the window is full one keyframe leaves (the
+  // oldest, or as `leaving` chooses; its record moves to Departed()).
   void AddKeyframe(int id, int frame_index, double timestamp, const SE3& world_from_kf,
                    const cv::Mat& image, const std::vector<LineSegment>& segments,
                    const std::vector<int>& previous_segment,
@@ -89,7 +93,7 @@ class WindowedBAKeyframes {
   bool WorldFromKeyframe(int id, SE3* world_from_kf) const;
   // The pose of the keyframe recorded just before `id`; false when there is none.
   bool WorldFromPreviousKeyframe(int id, SE3* world_from_previous) const;
-  // Records of keyframes that left the window, oldest first, and of the recorded ones.
+  // Records of keyframes that left the window, in the order they left, and of the recorded ones.
   const std::vector<KeyframePoseRecord>& Departed() const { return departed_; }
   std::vector<KeyframePoseRecord> Recorded() const;
 
@@ -107,8 +111,14 @@ class WindowedBAKeyframes {
     std::map<int, std::shared_ptr<const std::vector<WindowedBAPoint>>> points;
   };
 
+  // The fraction of a keyframe's points in view of the newest keyframe (every few points);
+  // -1 without points.
+  double VisibleInNewest(const Keyframe& keyframe) const;
+
   PinholeCamera camera_;
   int size_;
+  LeavingKeyframe leaving_;
+  double min_visible_;
   std::deque<Keyframe> keyframes_;  // oldest first
   int next_line_id_ = 0;
   std::map<long, Snapshot> submitted_;

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "backend/optimization/ba_linear_solver.h"
+#include "backend/windowed_ba/leaving_keyframe.h"
 #include "core/options.h"
 #include "residuals/affine_brightness.h"
 #include "residuals/photometric_residual.h"
@@ -104,6 +105,12 @@ struct WindowedBAOptions {
   // window into a prior on the poses of the others for the next window (DSO; marginalization.h);
   // false is a fixed lag (a leaving keyframe keeps its last pose, its rows are forgotten).
   bool marginalize = false;
+  // Which keyframe leaves a full window (leaving_keyframe.h): oldest (the newest `window`
+  // keyframes) or spread (DSO's choice: out of view first, else by the distance score; fixed lag
+  // only, since the prior marginalises the oldest). leaving_min_visible: the fraction of a
+  // keyframe's points in view of the newest keyframe below which it leaves first.
+  LeavingKeyframe leaving = LeavingKeyframe::kOldest;
+  double leaving_min_visible = 0.05;
   // sigma_b of the baseline prior (the scale gauge) as a fraction of the baseline. Without
   // inverse-depth priors any value > 0 gives the same optimum (the rows are scale-invariant);
   // 1e-2 keeps the system conditioned.
@@ -163,6 +170,12 @@ struct WindowedBAOptions {
     v.Field("marginalize", &marginalize,
             "Marginalise the keyframe leaving a full window into a prior on the others' poses "
             "(DSO); false: fixed lag (default false).");
+    v.Choice("leaving", &leaving, LeavingKeyframeNames(),
+             "Keyframe leaving a full window: oldest (default) or spread (DSO: out of view of "
+             "the newest first, else the distance score; not with marginalize).");
+    v.Field("leaving_min_visible", &leaving_min_visible,
+            "spread: a keyframe with less than this fraction of its points in view of the "
+            "newest keyframe leaves first (default 0.05).");
     v.Field("baseline_prior_sigma_ratio", &baseline_prior_sigma_ratio,
             "sigma of the scale prior as a fraction of the baseline.");
     v.Section("weighting", &weighting, "Weighting of the residual families and robust loss.");

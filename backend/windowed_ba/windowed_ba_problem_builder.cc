@@ -358,6 +358,12 @@ std::string WindowedBAOptions::Check() const {
   if (!(baseline_prior_sigma_ratio > 0.0) || !std::isfinite(baseline_prior_sigma_ratio)) {
     return "baseline_prior_sigma_ratio must be positive and finite";
   }
+  if (leaving == LeavingKeyframe::kSpread && marginalize) {
+    return "leaving: spread needs marginalize false (the prior marginalises the oldest keyframe)";
+  }
+  if (!(leaving_min_visible >= 0.0 && leaving_min_visible <= 1.0)) {
+    return "leaving_min_visible must be in [0, 1]";
+  }
   if (max_iterations < 0) return "max_iterations must be >= 0";
   if (!(function_tolerance >= 0.0)) return "function_tolerance must be >= 0";
   if (num_threads < 1) return "num_threads must be >= 1";

@@ -154,6 +154,22 @@ TEST(OdometryWindowedBATest, MarginalisedKeyframesLeaveAPriorForTheNextWindow) {
   EXPECT_EQ(run.stats.windowed_ba_prior_windows, run.stats.windowed_ba_windows - 2);
 }
 
+// leaving: spread with a window of 3 (keyframes may leave out of order): every window applies and
+// the keyframe poses come out once each, in time order.
+TEST(OdometryWindowedBATest, SpreadWindowsApplyAndKeyframesComeOutInTimeOrder) {
+  OdometryConfig config = Config(true);
+  config.backend.windowed_ba.window = 3;
+  config.backend.windowed_ba.leaving = LeavingKeyframe::kSpread;
+  const RunResult run = RunSequence(config);
+  for (const OdometryFrameResult& frame : run.frames) EXPECT_TRUE(IsTracked(frame.status));
+  ASSERT_GE(run.stats.windowed_ba_windows, 3);
+  EXPECT_EQ(run.stats.windowed_ba_applied, run.stats.windowed_ba_windows);
+  ASSERT_EQ(static_cast<int>(run.keyframes.size()), run.stats.keyframes);
+  for (size_t k = 1; k < run.keyframes.size(); ++k) {
+    EXPECT_LT(run.keyframes[k - 1].frame_index, run.keyframes[k].frame_index);
+  }
+}
+
 TEST(OdometryWindowedBATest, SynchronousModeRepeatsExactly) {
   const RunResult a = RunSequence(Config(true));
   const RunResult b = RunSequence(Config(true));
@@ -247,6 +263,13 @@ TEST(OdometryWindowedBATest, ConfigSectionReadsAndRejectsUnknownKeys) {
   config.backend.windowed_ba.window = 1;
   EXPECT_NE(config.Check().find("windowed_ba: window"), std::string::npos) << config.Check();
   config.backend.windowed_ba.window = 4;
+  ApplyOverrides({"backend.windowed_ba.leaving=spread"}, &config);
+  EXPECT_EQ(config.backend.windowed_ba.leaving, LeavingKeyframe::kSpread);
+  EXPECT_EQ(config.Check(), "");
+  config.backend.windowed_ba.marginalize = true;
+  EXPECT_NE(config.Check().find("leaving: spread needs marginalize false"), std::string::npos)
+      << config.Check();
+  config.backend.windowed_ba.marginalize = false;
   config.backend.edge_ba.enabled = true;
   EXPECT_NE(config.Check().find("cannot both be enabled"), std::string::npos) << config.Check();
 }
