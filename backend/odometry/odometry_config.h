@@ -200,6 +200,9 @@ struct OdometryOptions {
   // (backward_start.h). 0: frame 0 only. 300 bounds the start-up delay (about 17 s of backward
   // tracking at 640x480); measured against 90 in docs/bootstrap.md.
   int two_view_max_anchor = 300;
+  // ... and where the direction gate failed with the corners kept, again from the first frame
+  // that passed the parallax gates (measured in docs/bootstrap.md).
+  bool two_view_reanchor_after_direction_gate = true;
   // Its corners: cv::goodFeaturesToTrack's quality (relative to the strongest corner) and spacing;
   // the second view's adjusted translation direction: its largest standard deviation, and how
   // many consecutive frames' directions must agree to within that.
@@ -327,6 +330,10 @@ struct OdometryOptions {
             "Two-view bootstrap: where the corners are lost before a second view, the start "
             "begins again at the frame where they were lost, up to this frame; the frames before "
             "are tracked backwards from its map (0: frame 0 only; default 300).");
+    v.Field("two_view_reanchor_after_direction_gate", &two_view_reanchor_after_direction_gate,
+            "Two-view bootstrap: where the direction gate failed with the corners kept, start "
+            "again from the first frame that passed the parallax gates, up to "
+            "two_view_max_anchor (default true).");
     v.Field("two_view_corner_quality", &two_view_corner_quality,
             "Two-view bootstrap: smallest corner response relative to frame 0's strongest "
             "(cv::goodFeaturesToTrack qualityLevel, default 0.001).");

@@ -185,8 +185,9 @@ InitialMap PrepareInitialMap(const Dataset& dataset, const OdometryConfig& confi
   if (config.odometry.two_view_bootstrap && config.odometry.bootstrap_passes <= 1 &&
       config.odometry.init_depth_idepth_var <= 0.0 && num_frames > 0) {
     // From frame 0, and where its corners are lost before a second view, again from the frame
-    // where they were lost (up to two_view_max_anchor; not live, where the frames before it have
-    // gone by).
+    // where they were lost, or where the direction gate failed, from the first frame that passed
+    // the parallax gates (TwoViewRestartFrame; up to two_view_max_anchor; not live, where the
+    // frames before it have gone by).
     const int max_anchor = realtime ? 0 : config.odometry.two_view_max_anchor;
     int anchor = 0;
     while (true) {
@@ -243,10 +244,13 @@ InitialMap PrepareInitialMap(const Dataset& dataset, const OdometryConfig& confi
         const std::string where =
             anchor > 0 ? "the start from frame " + std::to_string(anchor) + ": " : "";
         const auto* failure = dynamic_cast<const TwoViewBootstrapFailure*>(&e);
-        // Frame `anchor` itself without enough corners: the next one.
-        const int next = failure != nullptr ? anchor + std::max(1, failure->tracks_lost_at) : 0;
-        if (failure == nullptr || failure->tracks_lost_at < 0 || next > max_anchor ||
-            num_frames - next < 2) {
+        const int restart =
+            failure != nullptr
+                ? TwoViewRestartFrame(*failure,
+                                      config.odometry.two_view_reanchor_after_direction_gate)
+                : -1;
+        const int next = anchor + restart;
+        if (restart < 0 || next > max_anchor || num_frames - next < 2) {
           std::cerr << "pldvo run: " << where << e.what()
                     << "; the run starts from the random map\n";
           break;

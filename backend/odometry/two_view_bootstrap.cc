@@ -397,6 +397,12 @@ void TrackReanchoredCorners(const Dataset& dataset, const OdometryOptions& optio
   }
 }
 
+int TwoViewRestartFrame(const TwoViewBootstrapFailure& failure, bool after_direction_gate) {
+  if (failure.tracks_lost_at >= 0) return std::max(1, failure.tracks_lost_at);
+  if (after_direction_gate && failure.first_gated >= 1) return failure.first_gated;
+  return -1;
+}
+
 TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryConfig& config,
                                        int num_frames, CornerTracks* unsettled_tracks) {
   const auto start = WallClock::now();
@@ -431,6 +437,7 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
   double best_free_px = -1.0;
   double best_direction_std_deg = std::numeric_limits<double>::infinity();
   int tested = 0;           // frames that passed the parallax gates
+  int first_gated = -1;     // the first of them
   int tracks_lost_at = -1;  // the frame where too few corners were left, if any
   // Frame 0's view of the adjusted directions to the camera centres of the latest consecutive
   // frames that passed the parallax gates (at most two_view_stable_frames).
@@ -470,7 +477,7 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
     const double direction_std_deg =
         BundleAdjust(tracks, track_ids, frames, K, &rotations, &translations, &points, true);
     best_direction_std_deg = std::min(best_direction_std_deg, direction_std_deg);
-    ++tested;
+    if (tested++ == 0) first_gated = k;
     directions.push_back(-(rotations.back().conjugate() * translations.back()).normalized());
     if (static_cast<int>(directions.size()) > options.two_view_stable_frames) {
       directions.pop_front();
@@ -529,7 +536,7 @@ TwoViewBootstrap BootstrapFromTwoViews(const Dataset& dataset, const OdometryCon
       why += "; corners detected again from frame " + std::to_string(tracks_lost_at) +
              " check the random start";
     }
-    throw TwoViewBootstrapFailure("two-view bootstrap: " + why, tracks_lost_at);
+    throw TwoViewBootstrapFailure("two-view bootstrap: " + why, tracks_lost_at, first_gated);
   }
   result.tracks = static_cast<int>(tracks.size());
   result.inliers = static_cast<int>(geometry.points.size());

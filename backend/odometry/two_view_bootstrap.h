@@ -67,13 +67,21 @@ struct TwoViewBootstrap {
 
 // Why a two-view start failed; tracks_lost_at is the frame where fewer than two_view_min_inliers
 // corners were left (0: frame 0 has fewer; -1 when the start failed otherwise): a later anchor
-// may start there.
+// may start there. first_gated: the first frame that passed the parallax gates (-1: none), where
+// a later anchor may start when the direction gate failed.
 class TwoViewBootstrapFailure : public std::runtime_error {
  public:
-  TwoViewBootstrapFailure(const std::string& what, int tracks_lost_at)
-      : std::runtime_error(what), tracks_lost_at(tracks_lost_at) {}
+  TwoViewBootstrapFailure(const std::string& what, int tracks_lost_at, int first_gated = -1)
+      : std::runtime_error(what), tracks_lost_at(tracks_lost_at), first_gated(first_gated) {}
   int tracks_lost_at;
+  int first_gated;
 };
+
+// Where a re-anchored start begins after `failure`, relative to the failed start's anchor: where
+// the corners were lost (the next frame if that is the anchor itself), or with
+// after_direction_gate, where the direction gate failed with the corners kept, the first frame
+// that passed the parallax gates; -1: nowhere (no parallax, no frames).
+int TwoViewRestartFrame(const TwoViewBootstrapFailure& failure, bool after_direction_gate);
 
 // The parallax of the matched pixels x0[i] <-> xk[i] that no rotation explains, px: the median
 // angle between the rays of xk and the rays of x0 turned by the rotation that best aligns them

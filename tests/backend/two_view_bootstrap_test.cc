@@ -353,6 +353,17 @@ TEST(TwoViewBootstrapTest, NearRotationIsRejectedByEitherGate) {
   const std::string by_direction = rejection(direction_gate);
   EXPECT_NE(by_direction.find("fixes the translation direction"), std::string::npos)
       << by_direction;
+  // The failure says where the parallax gates were first passed (the unguarded start's second
+  // view) and that no corner was lost: a re-anchored start may begin there.
+  try {
+    BootstrapFromTwoViews(dataset, direction_gate, kLowtexFrames);
+    ADD_FAILURE() << "the direction gate passed";
+  } catch (const TwoViewBootstrapFailure& failure) {
+    EXPECT_EQ(failure.tracks_lost_at, -1);
+    EXPECT_EQ(failure.first_gated, wrong.second_view);
+    EXPECT_EQ(TwoViewRestartFrame(failure, true), wrong.second_view);
+    EXPECT_EQ(TwoViewRestartFrame(failure, false), -1);
+  }
   // Failed at the direction gate: every corner's track for the random start's choice, those
   // alive to the last frame at least two_view_min_inliers, each from frame 0 on.
   CornerTracks unsettled;
@@ -371,6 +382,18 @@ TEST(TwoViewBootstrapTest, NearRotationIsRejectedByEitherGate) {
   const double truth_px = CornerEpipolarErrorPx(unsettled, truth, dataset.camera());
   std::printf("tracked corners' epipolar error against the ground truth: %.3f px\n", truth_px);
   EXPECT_LT(truth_px, 0.5);
+}
+
+// Where a chain of two-view starts begins again: where the corners were lost (the next frame when
+// the anchor itself has too few), else after a failed direction gate at the first frame that
+// passed the parallax gates, if asked; nowhere when no frame passed them.
+TEST(TwoViewBootstrapTest, RestartFrameFollowsTheFailure) {
+  EXPECT_EQ(TwoViewRestartFrame(TwoViewBootstrapFailure("", 12, 5), true), 12);
+  EXPECT_EQ(TwoViewRestartFrame(TwoViewBootstrapFailure("", 12, 5), false), 12);
+  EXPECT_EQ(TwoViewRestartFrame(TwoViewBootstrapFailure("", 0, -1), false), 1);
+  EXPECT_EQ(TwoViewRestartFrame(TwoViewBootstrapFailure("", -1, 7), true), 7);
+  EXPECT_EQ(TwoViewRestartFrame(TwoViewBootstrapFailure("", -1, 7), false), -1);
+  EXPECT_EQ(TwoViewRestartFrame(TwoViewBootstrapFailure("", -1, -1), true), -1);
 }
 
 // Corners lost after frames passed the parallax gates (a frame of noise after the near-rotation
