@@ -197,8 +197,8 @@ struct OdometryOptions {
   // Where the corners are lost (fewer than two_view_min_inliers) before a second view, the start
   // begins again at the frame where they were lost, as long as that frame is at most
   // two_view_max_anchor; the frames before it are tracked backwards from its map
-  // (backward_start.h). 0: frame 0 only. 300 bounds the start-up delay (about 17 s of backward
-  // tracking at 640x480); measured against 90 in docs/bootstrap.md.
+  // (backward_start.h). 0: frame 0 only. The cap bounds the start-up delay of the backward
+  // tracking (docs/bootstrap.md measures 300 against 90).
   int two_view_max_anchor = 300;
   // ... and where the direction gate failed with the corners kept, again from the first frame
   // that passed the parallax gates (measured in docs/bootstrap.md).

@@ -34,8 +34,8 @@ int ChooseLeavingKeyframe(const std::vector<LeavingCandidate>& keyframes, Leavin
   for (int i = 0; i < candidates; ++i) {
     double inverse_distances = 0.0;
     for (int j = 0; j < n; ++j) {
-      if (j != i)
-        inverse_distances += 1.0 / ((keyframes[i].centre - keyframes[j].centre).norm() + eps);
+      if (j == i) continue;
+      inverse_distances += 1.0 / ((keyframes[i].centre - keyframes[j].centre).norm() + eps);
     }
     const double score = std::sqrt((keyframes[i].centre - newest).norm()) * inverse_distances;
     if (score > best) {

@@ -1,5 +1,5 @@
-// Which keyframe leaves a full window (WindowedBAOptions::leaving; docs/windowed_ba.md, "Which
-// keyframe leaves"). `oldest` is a fixed lag. `spread` is DSO's keyframe marginalisation (Engel
+// Which keyframe leaves a full window (WindowedBAOptions::leaving; docs/windowed_ba.md, "What
+// leaves the window"). `oldest` is a fixed lag. `spread` is DSO's keyframe marginalisation (Engel
 // et al., PAMI 2018, Sec. 3.1 "Keyframe Marginalization"): a keyframe of which less than
 // `min_visible` of the points is still in view of the newest keyframe leaves first (the oldest
 // such); otherwise the one maximising the distance score
