@@ -75,12 +75,7 @@ TEST(LeavingKeyframeTest, RejectsAWindowWithNothingToLeave) {
 // spread the sixth keyframe makes 5.5 leave (the records keep ids 0, 1, 3, 4, 5); with oldest
 // keyframe 0 leaves. Departed() says which left.
 TEST(LeavingKeyframeTest, WindowedBAKeyframesKeepWhatTheChoiceKeeps) {
-  PinholeCamera camera;
-  camera.width = 32;
-  camera.height = 24;
-  camera.fx = camera.fy = 30.0;
-  camera.cx = 15.5;
-  camera.cy = 11.5;
+  const PinholeCamera camera{32, 24, 30.0, 30.0, 15.5, 11.5};  // width, height, fx, fy, cx, cy
   const cv::Mat image(camera.height, camera.width, CV_32F, cv::Scalar(100.0f));
   const std::vector<double> x = {0.0, 5.0, 5.5, 6.0, 6.5, 7.0};
   for (const LeavingKeyframe policy : {LeavingKeyframe::kSpread, LeavingKeyframe::kOldest}) {
