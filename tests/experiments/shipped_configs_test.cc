@@ -100,6 +100,7 @@ const std::map<std::string, std::function<void(const OdometryConfig&)>>& Cases()
          ExpectExtras(c, true, "points_lines");
          EXPECT_FALSE(c.backend.edge_ba.enabled);
          EXPECT_FALSE(c.backend.windowed_ba.enabled);
+         EXPECT_EQ(c.keyframes.max_relative_distance, 0.1);
        }},
       {"points_lines_edge_ba",
        [](const OdometryConfig& c) {
@@ -123,6 +124,7 @@ const std::map<std::string, std::function<void(const OdometryConfig&)>>& Cases()
          EXPECT_EQ(c.backend.windowed_ba.max_iterations, 20);
          EXPECT_TRUE(c.backend.windowed_ba.lines);
          EXPECT_EQ(c.backend.windowed_ba.interpolation, ImageInterpolation::kBicubic);
+         EXPECT_EQ(c.keyframes.max_relative_distance, 0.03);  // points_lines: 0.1
        }},
       {"sdvo",
        [](const OdometryConfig& c) {
