@@ -76,7 +76,7 @@ struct WeightingOptions {
   // image's contrast while the line weights, in pixels, do not) or estimated (from the previous
   // frame's photometric errors at its solution, EstimateIntensityNoiseSigma: scales with the
   // contrast, so the ratio of photometric to line weights does not; sigma_intensity then only
-  // serves the first frame).
+  // serves the first frame). The windowed BA takes the estimate of the newest tracked frame.
   NoiseSource intensity_noise = NoiseSource::kFixed;
   // Where the scale of a line's covariance Sigma_l (eq. 6) comes from: fixed (as the line
   // frontend fits it, lines.detector.endpoint_sigma_px) or estimated (Sigma_l times s^2, s from
@@ -111,9 +111,11 @@ struct WeightingOptions {
              "How photometric and point-to-line residuals are weighted: covariance (the paper), "
              "uniform, fixed_ratio, photometric_only, line_only.");
     v.Field("sigma_intensity", &sigma_intensity, "Image noise sigma_I in gray levels.");
-    v.Choice("intensity_noise", &intensity_noise, NoiseSourceNames(),
-             "Where sigma_I comes from: fixed (sigma_intensity) or estimated (from the previous "
-             "frame's photometric errors; contrast-invariant weights; tracking only).");
+    v.Choice(
+        "intensity_noise", &intensity_noise, NoiseSourceNames(),
+        "Where sigma_I comes from: fixed (sigma_intensity) or estimated (from the previous "
+        "frame's photometric errors; contrast-invariant weights; the windowed BA takes the newest "
+        "frame's).");
     v.Choice("line_noise", &line_noise, NoiseSourceNames(),
              "Scale of the lines' covariance: fixed (the line frontend's) or estimated (from the "
              "previous frame's point-to-line errors; tracking only).");

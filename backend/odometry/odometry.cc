@@ -269,6 +269,7 @@ void Odometry::UpdateWindowedBA(const KeyframeMap& map) {
     return;
   }
   WindowedBAWindow window = windowed_ba_keyframes_->MakeWindow();
+  window.intensity_noise_sigma = intensity_noise_sigma_;
   try {
     if (windowed_ba_adjuster_ != nullptr) {
       // Remember reads the ids and poses only; the adjuster gets the points.
@@ -621,7 +622,10 @@ void Odometry::UpdateReference(const std::vector<MatchedLine>& lines_in_cur,
     reference_source_ = map_->reference.get();
   }
   SetMatchedLines(lines_in_cur, &reference_);
-  reference_.intensity_noise_sigma = intensity_noise_sigma_;
+  reference_.intensity_noise_sigma =
+      config_.tracking.problem.weighting.intensity_noise == NoiseSource::kEstimated
+          ? intensity_noise_sigma_
+          : 0.0;
   reference_.line_noise_scale = line_noise_scale_;
   timing->reference_ms = MsSince(start);
 }
@@ -696,10 +700,7 @@ void Odometry::AcceptTrackedFrame(int index, const TrackingResult& tracking,
   world_from_last_good_ = world_from_cur;
   last_good_index_ = index;
   brightness_ = tracking.brightness;
-  if (config_.tracking.problem.weighting.intensity_noise == NoiseSource::kEstimated &&
-      tracking.intensity_noise_sigma > 0.0) {
-    intensity_noise_sigma_ = tracking.intensity_noise_sigma;
-  }
+  if (tracking.intensity_noise_sigma > 0.0) intensity_noise_sigma_ = tracking.intensity_noise_sigma;
   if (tracking.line_noise_scale > 0.0) line_noise_scale_ = tracking.line_noise_scale;
   retry_trigger_.Update(tracking);
   result->world_from_cam = world_from_cur;

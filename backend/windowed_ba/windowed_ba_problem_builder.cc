@@ -173,14 +173,19 @@ WindowedBAProblem PhotometricLineWindowBuilder::Build(const WindowedBAWindow& wi
   AddScaleGauge(&out);
   if (options_.marginalize && window.prior != nullptr) AddPrior(window, &out);
 
+  // eq. 5's sigma_I: tracking's estimate where weighting.intensity_noise is estimated.
+  WeightingOptions weighting = options_.weighting;
+  if (weighting.intensity_noise == NoiseSource::kEstimated && window.intensity_noise_sigma > 0.0) {
+    weighting.sigma_intensity = window.intensity_noise_sigma;
+  }
   ceres::LossFunction* loss = nullptr;
-  if (std::unique_ptr<ceres::LossFunction> made = MakeLossFunction(options_.weighting)) {
+  if (std::unique_ptr<ceres::LossFunction> made = MakeLossFunction(weighting)) {
     loss = problem.AddLossFunction(std::move(made));
   }
   ceres::LossFunction* loss_inside = loss_in_problem_ ? nullptr : loss;
   ceres::LossFunction* loss_outside = loss_in_problem_ ? loss : nullptr;
-  const bool photometric = UsesPhotometric(options_.weighting.policy);
-  const bool lines = options_.lines && UsesLines(options_.weighting.policy);
+  const bool photometric = UsesPhotometric(weighting.policy);
+  const bool lines = options_.lines && UsesLines(weighting.policy);
 
   std::vector<SE3> world_poses(n);
   for (int k = 0; k < n; ++k) world_poses[k] = PoseFromParameters(out.poses[k].data());
@@ -231,9 +236,9 @@ WindowedBAProblem PhotometricLineWindowBuilder::Build(const WindowedBAWindow& wi
         pixel.intensity_host = host_keyframe.pyramid->SampleIntensity(0, pixel.pixel_in_host.x(),
                                                                       pixel.pixel_in_host.y());
         // eq. 5 at the linearisation point; 0 where the row's reprojection is not samplable.
-        pixel.sqrt_info = PhotometricSqrtInfo(options_.weighting, camera, *keyframe(target).pyramid,
-                                              0, target_from_host, pixel.pixel_in_host,
-                                              point.idepth, point.idepth_var);
+        pixel.sqrt_info =
+            PhotometricSqrtInfo(weighting, camera, *keyframe(target).pyramid, 0, target_from_host,
+                                pixel.pixel_in_host, point.idepth, point.idepth_var);
         if (pixel.sqrt_info > 0.0) pending.pattern.push_back(pixel);
       }
       // A target where part of the pattern falls outside is left out: the rows would switch
@@ -259,7 +264,7 @@ WindowedBAProblem PhotometricLineWindowBuilder::Build(const WindowedBAWindow& wi
           continue;
         }
         const double sqrt_info =
-            LineSqrtInfo(options_.weighting, camera, target_from_host, point.pixel, point.idepth,
+            LineSqrtInfo(weighting, camera, target_from_host, point.pixel, point.idepth,
                          point.idepth_var, observation.line_in_target);  // eq. 6
         if (sqrt_info > 0.0) {
           pending_point.lines.push_back({target, observation.line_in_target.line, sqrt_info});
@@ -370,10 +375,10 @@ std::string WindowedBAOptions::Check() const {
   if (max_queue < 1) return "max_queue must be >= 1";
   const std::string weighting_error = weighting.Check();
   if (!weighting_error.empty()) return "weighting: " + weighting_error;
-  // The noise estimates come from a tracked frame's solution, which a window does not have.
-  if (weighting.intensity_noise != NoiseSource::kFixed ||
-      weighting.line_noise != NoiseSource::kFixed) {
-    return "weighting: intensity_noise and line_noise must be fixed (estimated is tracking's)";
+  // sigma_I comes from tracking (WindowedBAWindow::intensity_noise_sigma); the line noise scale
+  // is a tracked frame's, which a window does not have.
+  if (weighting.line_noise != NoiseSource::kFixed) {
+    return "weighting: line_noise must be fixed (estimated is tracking's)";
   }
   return "";
 }

@@ -18,6 +18,9 @@ void CheckWindowedBAWindow(const WindowedBAWindow& window) {
   const std::string camera_error = window.camera.Check();
   if (!camera_error.empty()) Throw(__LINE__, "camera: " + camera_error);
   if (window.keyframes.size() < 2) Throw(__LINE__, "fewer than 2 keyframes");
+  if (!(window.intensity_noise_sigma >= 0.0) || !std::isfinite(window.intensity_noise_sigma)) {
+    Throw(__LINE__, "intensity_noise_sigma must be >= 0 and finite");
+  }
   for (size_t k = 0; k < window.keyframes.size(); ++k) {
     const WindowedBAKeyframe& keyframe = window.keyframes[k];
     const std::string name = "keyframe " + std::to_string(keyframe.id);

@@ -52,12 +52,18 @@ struct WindowedBAWindow {
   // What earlier windows left when their oldest keyframes left (WindowedBAOptions::marginalize);
   // null: none.
   std::shared_ptr<const WindowedBAPrior> prior;
+  // sigma_I (gray levels) that tracking estimated from its newest frame's photometric errors;
+  // with weighting.intensity_noise estimated it replaces weighting.sigma_intensity in eq. 5,
+  // which keeps the photometric rows' weight relative to the line rows and the priors
+  // independent of the image's contrast. 0: none (the configured sigma_intensity).
+  double intensity_noise_sigma = 0.0;
 };
 
 // Throws std::invalid_argument naming the keyframe / point when the window is malformed (invalid
-// camera, fewer than 2 keyframes, ids not increasing, missing pyramid or one whose level 0
-// differs from the camera, non-finite pose, a point with non-finite pixel or non-positive
-// idepth / idepth_var, a line observation whose line is not normalised, a malformed prior).
+// camera, fewer than 2 keyframes, a negative or non-finite intensity_noise_sigma, ids not
+// increasing, missing pyramid or one whose level 0 differs from the camera, non-finite pose, a
+// point with non-finite pixel or non-positive idepth / idepth_var, a line observation whose line is
+// not normalised, a malformed prior).
 void CheckWindowedBAWindow(const WindowedBAWindow& window);
 
 }  // namespace pldvo

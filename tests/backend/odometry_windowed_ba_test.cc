@@ -170,6 +170,28 @@ TEST(OdometryWindowedBATest, SpreadWindowsApplyAndKeyframesComeOutInTimeOrder) {
   }
 }
 
+// backend.windowed_ba.weighting.intensity_noise estimated: every window weighs its photometric
+// rows with the sigma_I that tracking estimated, so the BA's sigma_intensity no longer matters;
+// fixed, it does. 14 frames: keyframes 0, 6 and 12, two windows.
+TEST(OdometryWindowedBATest, EstimatedIntensityNoiseComesFromTracking) {
+  auto keyframe_poses = [](bool estimated, double sigma_intensity) {
+    OdometryConfig config = Config(true);
+    WeightingOptions& weighting = config.backend.windowed_ba.weighting;
+    weighting.intensity_noise = estimated ? NoiseSource::kEstimated : NoiseSource::kFixed;
+    weighting.sigma_intensity = sigma_intensity;
+    const RunResult run = RunSequence(config, 14);
+    EXPECT_GE(run.stats.windowed_ba_applied, 2);
+    std::vector<Eigen::Vector3d> centres;
+    for (const KeyframePoseRecord& keyframe : run.keyframes) {
+      centres.push_back(keyframe.world_from_kf.translation());
+    }
+    return centres;
+  };
+  const std::vector<Eigen::Vector3d> estimated = keyframe_poses(true, 4.0);
+  EXPECT_EQ(keyframe_poses(true, 1000.0), estimated);
+  EXPECT_NE(keyframe_poses(false, 4.0), estimated);
+}
+
 TEST(OdometryWindowedBATest, SynchronousModeRepeatsExactly) {
   const RunResult a = RunSequence(Config(true));
   const RunResult b = RunSequence(Config(true));

@@ -7,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <string>
 #include <utility>
@@ -309,6 +310,63 @@ TEST(WindowedBATest, ProblemHasTheGaugeAndCovarianceWeights) {
     EXPECT_TRUE(
         without.problem.parameter_blocks()[without.problem.ParameterBlockIndex(brightness.data())]
             .constant);
+  }
+}
+
+// The photometric rows' sqrt_info of a problem, block by block (the builder adds them in a
+// fixed order).
+std::vector<double> PhotometricSqrtInfos(const WindowedBAProblem& problem) {
+  std::vector<double> sqrt_infos;
+  for (const LeastSquaresProblem::ResidualBlock& block : problem.problem.residual_blocks()) {
+    const auto* photometric =
+        dynamic_cast<const HostTargetPhotometricResidual*>(block.cost_function);
+    if (photometric == nullptr) continue;
+    for (const HostPixel& pixel : photometric->pattern()) sqrt_infos.push_back(pixel.sqrt_info);
+  }
+  return sqrt_infos;
+}
+
+// weighting.intensity_noise estimated: eq. 5's sigma_I is the window's (tracking's estimate),
+// as if configured; a window without one keeps sigma_intensity. The line rows do not change.
+TEST(WindowedBATest, EstimatedIntensityNoiseIsTheWindowsSigma) {
+  WindowedBASimulation simulation = SmallWindow();
+  WindowedBAOptions options;
+  options.window = 3;
+  options.max_points = 150;
+  const WindowedBAProblem configured =
+      MakeWindowedBAProblemBuilder("windowed_ba", options)->Build(simulation.window);
+  WindowedBAOptions small_sigma = options;
+  small_sigma.weighting.sigma_intensity = 0.5;
+  const WindowedBAProblem fixed_half =
+      MakeWindowedBAProblemBuilder("windowed_ba", small_sigma)->Build(simulation.window);
+  WindowedBAOptions estimated = options;
+  estimated.weighting.intensity_noise = NoiseSource::kEstimated;
+  EXPECT_EQ(estimated.Check(), "");
+  const auto builder = MakeWindowedBAProblemBuilder("windowed_ba", estimated);
+  const WindowedBAProblem without_estimate = builder->Build(simulation.window);
+  simulation.window.intensity_noise_sigma = 0.5;
+  const WindowedBAProblem with_estimate = builder->Build(simulation.window);
+
+  const std::vector<double> expected = PhotometricSqrtInfos(fixed_half);
+  ASSERT_GT(expected.size(), 1000u);
+  EXPECT_EQ(PhotometricSqrtInfos(with_estimate), expected);
+  EXPECT_EQ(PhotometricSqrtInfos(without_estimate), PhotometricSqrtInfos(configured));
+  // Eq. 5 at sigma_I = 4 and 0.5: every row weighs more with the smaller noise.
+  const std::vector<double> at_four = PhotometricSqrtInfos(configured);
+  ASSERT_EQ(at_four.size(), expected.size());
+  for (size_t i = 0; i < expected.size(); ++i) EXPECT_GT(expected[i], at_four[i]) << i;
+  EXPECT_EQ(with_estimate.num_line_rows, configured.num_line_rows);
+  EXPECT_GT(configured.num_line_rows, 0);
+
+  for (const double bad : {-1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    simulation.window.intensity_noise_sigma = bad;
+    try {
+      builder->Build(simulation.window);
+      ADD_FAILURE() << "intensity_noise_sigma " << bad << " accepted";
+    } catch (const std::invalid_argument& error) {
+      EXPECT_NE(std::string(error.what()).find("intensity_noise_sigma"), std::string::npos)
+          << error.what();
+    }
   }
 }
 
