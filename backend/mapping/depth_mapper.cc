@@ -396,6 +396,9 @@ SemiDenseDepthMap DepthMapper::RegularizedMap(bool smooth, bool line_regularize,
   } else {
     result = map_;
   }
+  if (options_.line_depth_gate && !edges_.lines.empty()) {
+    LineRegularizer(options_).UnlinkOutliers(camera_, edges_, &result);
+  }
   if (line_regularize && !edges_.lines.empty()) {
     const LineRegularizer regularizer(options_);
     const LineRegularizationStats line_stats = regularizer.Regularize(camera_, edges_, &result);

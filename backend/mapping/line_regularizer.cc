@@ -339,4 +339,32 @@ LineRegularizationStats LineRegularizer::Regularize(const PinholeCamera& camera,
   return stats;
 }
 
+LineRegularizationStats LineRegularizer::UnlinkOutliers(const PinholeCamera& camera,
+                                                        const EdgeTrace& edges,
+                                                        SemiDenseDepthMap* map) const {
+  LineRegularizationStats stats;
+  std::mt19937 rng(static_cast<uint32_t>(options_.line_ransac_seed));
+  for (const TracedLine& edge : edges.lines) {
+    if (edge.pixels.empty()) continue;
+    const LineFit fit = FitEdge(camera, edge.segment.line, edge.pixels, *map, &rng);
+    if (fit.ok) {
+      ++stats.edges_fitted;
+    } else if (fit.num_used >= options_.line_min_pixels) {
+      ++stats.edges_rejected;
+    } else {
+      continue;  // too few depths to judge: the edge keeps its pixels
+    }
+    for (size_t i = 0; i < edge.pixels.size(); ++i) {
+      const Eigen::Vector2i& p = edge.pixels[i];
+      if (p.x() < 0 || p.y() < 0 || p.x() >= map->width() || p.y() >= map->height()) continue;
+      const int index = map->Index(p.x(), p.y());
+      if (!map->valid(index) || map->edge_id(index) != edge.id) continue;
+      if (fit.ok && fit.inlier[i]) continue;
+      map->SetCandidate(index, map->candidate(index), -1);
+      ++stats.pixels_unlinked;
+    }
+  }
+  return stats;
+}
+
 }  // namespace pldvo

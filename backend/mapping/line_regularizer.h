@@ -78,6 +78,7 @@ struct LineRegularizationStats {
   int edges_rejected = 0;  // too few valid pixels or inliers, or degenerate
   int pixels_updated = 0;
   int pixels_rejected = 0;  // outliers of fitted edges
+  int pixels_unlinked = 0;  // UnlinkOutliers: valid pixels taken off their edge
 };
 
 class LineRegularizer {
@@ -94,6 +95,12 @@ class LineRegularizer {
   // Fits every traced edge and updates its inliers in `map` (see the header comment).
   LineRegularizationStats Regularize(const PinholeCamera& camera, const EdgeTrace& edges,
                                      SemiDenseDepthMap* map) const;
+
+  // MappingOptions::line_depth_gate: fits every traced edge as Regularize does and takes the
+  // valid pixels the fit rejects off their edge (edge id -1, depths unchanged); an edge whose
+  // fit fails with at least line_min_pixels valid pixels loses all of them.
+  LineRegularizationStats UnlinkOutliers(const PinholeCamera& camera, const EdgeTrace& edges,
+                                         SemiDenseDepthMap* map) const;
 
  private:
   // The paper's fit (eqs. 11-13) of the valid pixels with in-plane rays `rays`; fills *fit.

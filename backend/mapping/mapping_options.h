@@ -174,6 +174,12 @@ struct MappingOptions {
   int line_min_pixels = 10;            // edges with fewer valid pixels are not regularised
   double line_min_inlier_ratio = 0.5;  // of the valid pixels
   int line_ransac_seed = 7;
+  // Point-to-line rows only where the edge's depths agree with one 3D line: the same fit (with
+  // or without line_regularization) unlinks the valid pixels it rejects from their edge in the
+  // map tracking reads, and all of an edge's valid pixels when the edge has too few inliers;
+  // their photometric rows stay. An occluding edge's traced band holds the far surface's
+  // depths on one side, which move unlike the edge when the camera translates.
+  bool line_depth_gate = false;
 
   // ---- Propagation to a new keyframe (Engel 2013 Sec. 2.4).
   // sigma_p^2 added to every propagated variance, (1/m)^2.
@@ -297,6 +303,9 @@ struct MappingOptions {
             "Fill invalid candidates with at least this many valid neighbours (8).");
     v.Field("line_regularization", &line_regularization,
             "3D line regularisation of edges, eqs. 11-13 (default false).");
+    v.Field("line_depth_gate", &line_depth_gate,
+            "Edge pixels whose inverse depths the edge's 3D line fit rejects (and every pixel of "
+            "an edge with too few inliers) get no point-to-line rows (default false).");
     v.Choice("line_regularization_method", &line_regularization_method,
              {{"ray_1d", LineRegularizationMethod::kRay1d},
               {"paper_2d", LineRegularizationMethod::kPaper2d}},

@@ -380,6 +380,11 @@ std::string WindowedBAOptions::Check() const {
   if (weighting.line_noise != NoiseSource::kFixed) {
     return "weighting: line_noise must be fixed (estimated is tracking's)";
   }
+  // The window's point-to-line rows are per pixel (eq. 6); one shared error per edge is
+  // tracking's only, and accepting it here would change nothing.
+  if (weighting.line_error_model != LineErrorModel::kPerPixel) {
+    return "weighting: line_error_model must be per_pixel (shared_per_edge is tracking's)";
+  }
   return "";
 }
 

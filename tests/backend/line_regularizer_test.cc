@@ -201,5 +201,78 @@ TEST(LineRegularizerTest, TooFewPixelsIsRejected) {
   EXPECT_FALSE(regularizer.FitEdge(camera, line.segment.line, line.pixels, map, &rng).ok);
 }
 
+// The line depth gate (MappingOptions::line_depth_gate): an occluding edge whose band holds 20%
+// far-surface depths keeps exactly the pixels the fit accepts on the edge, depths unchanged; an
+// edge of mostly inconsistent depths leaves the edge entirely; an edge with too few depths to
+// judge keeps its pixels.
+TEST(LineRegularizerTest, UnlinkOutliersTakesTheRejectedDepthsOffTheirEdge) {
+  const PinholeCamera camera = TestCamera();
+  MappingOptions options;
+  const LineRegularizer regularizer(options);
+  std::mt19937 rng(3);
+  SemiDenseDepthMap map(camera.width, camera.height);
+  EdgeCase edge = MakeEdge(camera, Eigen::Vector3d(-0.6, -0.2, 2.0), Eigen::Vector3d(0.5, 0.3, 2.6),
+                           0.02, 0.2, &rng, &map);
+  edge.line.id = 4;
+  for (const Eigen::Vector2i& p : edge.line.pixels) {
+    map.SetCandidate(map.Index(p.x(), p.y()), true, edge.line.id);
+  }
+  std::mt19937 fit_rng(static_cast<uint32_t>(options.line_ransac_seed));
+  const LineFit fit =
+      regularizer.FitEdge(camera, edge.line.segment.line, edge.line.pixels, map, &fit_rng);
+  ASSERT_TRUE(fit.ok);
+  const SemiDenseDepthMap before = map;
+  EdgeTrace trace;
+  trace.lines.push_back(edge.line);
+  const LineRegularizationStats stats = regularizer.UnlinkOutliers(camera, trace, &map);
+  int unlinked = 0, outliers = 0;
+  for (size_t i = 0; i < edge.line.pixels.size(); ++i) {
+    const int index = map.Index(edge.line.pixels[i].x(), edge.line.pixels[i].y());
+    EXPECT_EQ(map.edge_id(index), fit.inlier[i] ? edge.line.id : -1) << "pixel " << i;
+    EXPECT_EQ(map.idepth(index), before.idepth(index));
+    EXPECT_EQ(map.idepth_var(index), before.idepth_var(index));
+    EXPECT_TRUE(map.candidate(index));
+    unlinked += map.edge_id(index) < 0;
+    if (edge.outlier[i]) {
+      ++outliers;
+      EXPECT_EQ(map.edge_id(index), -1) << "pixel " << i;
+    }
+  }
+  EXPECT_GT(outliers, 5);
+  EXPECT_LE(unlinked, outliers + 0.05 * edge.line.pixels.size());
+  EXPECT_EQ(stats.pixels_unlinked, unlinked);
+  EXPECT_EQ(stats.edges_fitted, 1);
+
+  // Mostly inconsistent: 70% of the depths off the line, no 50% inlier set.
+  SemiDenseDepthMap scattered(camera.width, camera.height);
+  EdgeCase bad = MakeEdge(camera, Eigen::Vector3d(-0.6, -0.2, 2.0), Eigen::Vector3d(0.5, 0.3, 2.6),
+                          0.02, 0.0, &rng, &scattered);
+  bad.line.id = 0;
+  std::uniform_real_distribution<double> spread(0.3, 3.0);
+  for (size_t i = 0; i < bad.line.pixels.size(); ++i) {
+    const int index = scattered.Index(bad.line.pixels[i].x(), bad.line.pixels[i].y());
+    if (i % 10 < 7) scattered.Set(index, spread(rng), 1e-4, 20);
+    scattered.SetCandidate(index, true, bad.line.id);
+  }
+  trace.lines.assign(1, bad.line);
+  const LineRegularizationStats bad_stats = regularizer.UnlinkOutliers(camera, trace, &scattered);
+  EXPECT_EQ(bad_stats.edges_rejected, 1);
+  EXPECT_EQ(bad_stats.pixels_unlinked, static_cast<int>(bad.line.pixels.size()));
+
+  // Five depths cannot be judged (line_min_pixels 10): the edge keeps them.
+  SemiDenseDepthMap few(camera.width, camera.height);
+  TracedLine short_line;
+  short_line.id = 2;
+  short_line.segment = MakeLineSegment(Eigen::Vector2d(10, 10), Eigen::Vector2d(20, 10), 0, 0.5);
+  for (int x = 10; x < 15; ++x) {
+    short_line.pixels.emplace_back(x, 10);
+    few.Set(few.Index(x, 10), x == 12 ? 2.0 : 0.5, 0.01, 20);
+    few.SetCandidate(few.Index(x, 10), true, short_line.id);
+  }
+  trace.lines.assign(1, short_line);
+  EXPECT_EQ(regularizer.UnlinkOutliers(camera, trace, &few).pixels_unlinked, 0);
+  for (int x = 10; x < 15; ++x) EXPECT_EQ(few.edge_id(few.Index(x, 10)), short_line.id);
+}
+
 }  // namespace
 }  // namespace pldvo

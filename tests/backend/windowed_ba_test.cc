@@ -615,6 +615,9 @@ TEST(WindowedBATest, RegistryAndOptions) {
   options = WindowedBAOptions();
   options.weighting.line_noise = NoiseSource::kEstimated;
   EXPECT_NE(options.Check().find("line_noise must be fixed"), std::string::npos);
+  options = WindowedBAOptions();
+  options.weighting.line_error_model = LineErrorModel::kSharedPerEdge;
+  EXPECT_NE(options.Check().find("line_error_model must be per_pixel"), std::string::npos);
 }
 
 }  // namespace
