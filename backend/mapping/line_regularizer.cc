@@ -3,11 +3,19 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 
 namespace pldvo {
 namespace {
+
+// The map index of traced pixel p when it lies in the map and holds a valid hypothesis, else -1.
+int ValidIndex(const SemiDenseDepthMap& map, const Eigen::Vector2i& p) {
+  if (p.x() < 0 || p.y() < 0 || p.x() >= map.width() || p.y() >= map.height()) return -1;
+  const int index = map.Index(p.x(), p.y());
+  return map.valid(index) ? index : -1;
+}
 
 // Weighted least squares of d = x^T c over the selected samples; false when degenerate.
 bool SolveWeighted(const std::vector<Eigen::Vector2d>& rays, const std::vector<double>& idepths,
@@ -302,29 +310,34 @@ void LineRegularizer::FitPaper2d(const std::vector<Eigen::Vector2d>& rays,
   fit->inlier = inlier;
 }
 
+void LineRegularizer::FitEdges(
+    const PinholeCamera& camera, const EdgeTrace& edges, const SemiDenseDepthMap& map,
+    const std::function<void(const TracedLine&, const LineFit&)>& on_edge) const {
+  std::mt19937 rng(static_cast<uint32_t>(options_.line_ransac_seed));
+  for (const TracedLine& edge : edges.lines) {
+    if (edge.pixels.empty()) continue;
+    on_edge(edge, FitEdge(camera, edge.segment.line, edge.pixels, map, &rng));
+  }
+}
+
 LineRegularizationStats LineRegularizer::Regularize(const PinholeCamera& camera,
                                                     const EdgeTrace& edges,
                                                     SemiDenseDepthMap* map) const {
   LineRegularizationStats stats;
-  std::mt19937 rng(static_cast<uint32_t>(options_.line_ransac_seed));
-  for (const TracedLine& edge : edges.lines) {
-    if (edge.pixels.empty()) continue;
-    const LineFit fit = FitEdge(camera, edge.segment.line, edge.pixels, *map, &rng);
+  FitEdges(camera, edges, *map, [&](const TracedLine& edge, const LineFit& fit) {
     if (!fit.ok) {
       if (fit.num_used > 0) ++stats.edges_rejected;
-      continue;
+      return;
     }
     ++stats.edges_fitted;
     for (size_t i = 0; i < edge.pixels.size(); ++i) {
-      const Eigen::Vector2i& p = edge.pixels[i];
-      if (p.x() < 0 || p.y() < 0 || p.x() >= map->width() || p.y() >= map->height()) continue;
-      const int index = map->Index(p.x(), p.y());
-      if (!map->valid(index)) continue;
+      const int index = ValidIndex(*map, edge.pixels[i]);
+      if (index < 0) continue;
       if (!fit.inlier[i]) {
         ++stats.pixels_rejected;
         continue;
       }
-      const Eigen::Vector3d ray = camera.Unproject(p.cast<double>());
+      const Eigen::Vector3d ray = camera.Unproject(edge.pixels[i].cast<double>());
       const Eigen::Vector2d x(fit.e_x.dot(ray), fit.e_y.dot(ray));
       const double idepth = x.dot(fit.coeffs);
       if (!(idepth > 0.0)) continue;
@@ -335,7 +348,7 @@ LineRegularizationStats LineRegularizer::Regularize(const PinholeCamera& camera,
       map->SetIdepthAndVar(index, idepth, var);
       ++stats.pixels_updated;
     }
-  }
+  });
   return stats;
 }
 
@@ -343,27 +356,21 @@ LineRegularizationStats LineRegularizer::UnlinkOutliers(const PinholeCamera& cam
                                                         const EdgeTrace& edges,
                                                         SemiDenseDepthMap* map) const {
   LineRegularizationStats stats;
-  std::mt19937 rng(static_cast<uint32_t>(options_.line_ransac_seed));
-  for (const TracedLine& edge : edges.lines) {
-    if (edge.pixels.empty()) continue;
-    const LineFit fit = FitEdge(camera, edge.segment.line, edge.pixels, *map, &rng);
+  FitEdges(camera, edges, *map, [&](const TracedLine& edge, const LineFit& fit) {
     if (fit.ok) {
       ++stats.edges_fitted;
     } else if (fit.num_used >= options_.line_min_pixels) {
       ++stats.edges_rejected;
     } else {
-      continue;  // too few depths to judge: the edge keeps its pixels
+      return;  // too few depths to judge: the edge keeps its pixels
     }
     for (size_t i = 0; i < edge.pixels.size(); ++i) {
-      const Eigen::Vector2i& p = edge.pixels[i];
-      if (p.x() < 0 || p.y() < 0 || p.x() >= map->width() || p.y() >= map->height()) continue;
-      const int index = map->Index(p.x(), p.y());
-      if (!map->valid(index) || map->edge_id(index) != edge.id) continue;
-      if (fit.ok && fit.inlier[i]) continue;
+      const int index = ValidIndex(*map, edge.pixels[i]);
+      if (index < 0 || map->edge_id(index) != edge.id || (fit.ok && fit.inlier[i])) continue;
       map->SetCandidate(index, map->candidate(index), -1);
       ++stats.pixels_unlinked;
     }
-  }
+  });
   return stats;
 }
 

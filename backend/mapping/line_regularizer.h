@@ -46,6 +46,7 @@
 #define PLDVO_BACKEND_MAPPING_LINE_REGULARIZER_H_
 
 #include <Eigen/Core>
+#include <functional>
 #include <random>
 #include <vector>
 
@@ -103,6 +104,11 @@ class LineRegularizer {
                                          SemiDenseDepthMap* map) const;
 
  private:
+  // Fits every traced edge with pixels, in order, with one RANSAC stream seeded by
+  // line_ransac_seed, and hands each fit to on_edge (which may change `map` for later edges).
+  void FitEdges(const PinholeCamera& camera, const EdgeTrace& edges, const SemiDenseDepthMap& map,
+                const std::function<void(const TracedLine&, const LineFit&)>& on_edge) const;
+
   // The paper's fit (eqs. 11-13) of the valid pixels with in-plane rays `rays`; fills *fit.
   void FitPaper2d(const std::vector<Eigen::Vector2d>& rays, const std::vector<double>& idepths,
                   const std::vector<double>& vars, std::vector<uint8_t> valid,
