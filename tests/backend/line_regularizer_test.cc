@@ -201,8 +201,8 @@ TEST(LineRegularizerTest, TooFewPixelsIsRejected) {
   EXPECT_FALSE(regularizer.FitEdge(camera, line.segment.line, line.pixels, map, &rng).ok);
 }
 
-// The line depth gate (MappingOptions::line_depth_gate): an occluding edge whose band holds 20%
-// far-surface depths keeps exactly the pixels the fit accepts on the edge, depths unchanged; an
+// The line depth gate (MappingOptions::line_depth_gate): an edge whose band holds 20% depths of
+// another surface keeps exactly the pixels the fit accepts on the edge, depths unchanged; an
 // edge of mostly inconsistent depths leaves the edge entirely; an edge with too few depths to
 // judge keeps its pixels.
 TEST(LineRegularizerTest, UnlinkOutliersTakesTheRejectedDepthsOffTheirEdge) {
