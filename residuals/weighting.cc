@@ -55,6 +55,12 @@ double IntensityNoiseFactor(WeightingPolicy policy) {
   return 0.0;
 }
 
+double IntensityNoiseSigma(const WeightingOptions& options, double estimate) {
+  return options.intensity_noise == NoiseSource::kEstimated && estimate > 0.0
+             ? estimate
+             : options.sigma_intensity;
+}
+
 double EstimateIntensityNoiseSigma(const std::vector<double>& errors,
                                    const std::vector<double>& other_variances,
                                    double noise_factor) {

@@ -167,6 +167,11 @@ EdgeLineWeights SharedLineErrorWeights(const LineWithCovariance& line_in_cur,
 // 0 where sigma_I does not enter (uniform, line_only).
 double IntensityNoiseFactor(WeightingPolicy policy);
 
+// sigma_I of eq. 5 (gray levels): `estimate` (EstimateIntensityNoiseSigma of an earlier
+// solution) where options.intensity_noise is estimated and an estimate exists (> 0), otherwise
+// options.sigma_intensity.
+double IntensityNoiseSigma(const WeightingOptions& options, double estimate);
+
 // The image noise sigma_I (gray levels) that the photometric errors e_i at a solution imply,
 // given each row's variance k sigma_I^2 + D_i (k = noise_factor, D_i = other_variances[i], the
 // depth part of eq. 5): the sigma at which the whitened errors have unit robust scale,

@@ -396,11 +396,10 @@ SemiDenseDepthMap DepthMapper::RegularizedMap(bool smooth, bool line_regularize,
   } else {
     result = map_;
   }
-  if (options_.line_depth_gate && !edges_.lines.empty()) {
-    LineRegularizer(options_).UnlinkOutliers(camera_, edges_, &result);
-  }
-  if (line_regularize && !edges_.lines.empty()) {
-    const LineRegularizer regularizer(options_);
+  if (edges_.lines.empty() || !(options_.line_depth_gate || line_regularize)) return result;
+  const LineRegularizer regularizer(options_);
+  if (options_.line_depth_gate) regularizer.UnlinkOutliers(camera_, edges_, &result);
+  if (line_regularize) {
     const LineRegularizationStats line_stats = regularizer.Regularize(camera_, edges_, &result);
     if (stats) *stats = line_stats;
   }

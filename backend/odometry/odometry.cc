@@ -622,10 +622,7 @@ void Odometry::UpdateReference(const std::vector<MatchedLine>& lines_in_cur,
     reference_source_ = map_->reference.get();
   }
   SetMatchedLines(lines_in_cur, &reference_);
-  reference_.intensity_noise_sigma =
-      config_.tracking.problem.weighting.intensity_noise == NoiseSource::kEstimated
-          ? intensity_noise_sigma_
-          : 0.0;
+  reference_.intensity_noise_sigma = intensity_noise_sigma_;
   reference_.line_noise_scale = line_noise_scale_;
   timing->reference_ms = MsSince(start);
 }

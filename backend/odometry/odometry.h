@@ -274,9 +274,9 @@ class Odometry {
   // affine; 0 with none and after a new keyframe): the next frame's initial guess, and what its
   // mapping job undoes (MappingJob::brightness).
   AffineBrightness brightness_;
-  // sigma_I of the last tracked frame's solution (0 until one): the next frame's tracking
-  // reference gets it (tracking.problem.weighting.intensity_noise estimated), every windowed BA
-  // window too (its weighting.intensity_noise estimated).
+  // sigma_I of the last tracked frame's solution (0 until one), handed to the next frame's
+  // tracking reference and to every windowed BA window; each uses it where its
+  // weighting.intensity_noise is estimated.
   double intensity_noise_sigma_ = 0.0;
   // The line covariance scale s of the last tracked frame's solution with line rows (0 before
   // the first): the next frame's tracking reference gets it (weighting.line_noise estimated

@@ -177,8 +177,7 @@ double Tracker::IntensityNoiseAtSolution(const TrackingReference& reference,
                                          const ResidualStatistics& stats) const {
   const WeightingOptions& weighting = options_.problem.weighting;
   const double noise_factor = IntensityNoiseFactor(weighting.policy);
-  const double sigma_used = reference.intensity_noise_sigma > 0.0 ? reference.intensity_noise_sigma
-                                                                  : weighting.sigma_intensity;
+  const double sigma_used = IntensityNoiseSigma(weighting, reference.intensity_noise_sigma);
   // Each row's variance was noise_factor sigma_used^2 + D_i: recover D_i from its sqrt_info.
   std::vector<double> errors, other_variances;
   for (size_t i = 0; i < stats.photometric_errors.size(); ++i) {

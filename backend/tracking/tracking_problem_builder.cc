@@ -120,11 +120,9 @@ BuildStatistics TrackingProblemBuilder::Build(const TrackingReference& reference
   const TrackingReferenceLevel& ref = reference.levels[level];
   const PinholeCamera& camera = ref.camera;
   const SE3 pose = PoseFromParameters(cur_from_ref);
-  // The reference's sigma_I, when it has one (weighting.intensity_noise estimated).
+  // The reference's sigma_I where weighting.intensity_noise is estimated.
   WeightingOptions weighting = options_.weighting;
-  if (reference.intensity_noise_sigma > 0.0) {
-    weighting.sigma_intensity = reference.intensity_noise_sigma;
-  }
+  weighting.sigma_intensity = IntensityNoiseSigma(weighting, reference.intensity_noise_sigma);
   // With weighting.line_noise estimated, the reference's line noise scale s multiplies every
   // Sigma_l by s^2.
   const double line_noise_scale = reference.line_noise_scale;

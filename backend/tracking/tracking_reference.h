@@ -49,9 +49,9 @@ struct TrackingReferenceLevel {
 
 struct TrackingReference {
   std::vector<TrackingReferenceLevel> levels;  // levels[0] is full resolution
-  // sigma_I of the photometric weights for the frames tracked against it, gray levels; 0: the
-  // configured tracking.problem.weighting.sigma_intensity (weighting.intensity_noise estimated
-  // sets it from the previous frame, EstimateIntensityNoiseSigma).
+  // sigma_I estimated from the previous frame's solution (EstimateIntensityNoiseSigma), gray
+  // levels; the photometric weights use it where weighting.intensity_noise is estimated
+  // (IntensityNoiseSigma). 0: none (the configured sigma_intensity).
   double intensity_noise_sigma = 0.0;
   // s of the line rows' covariance s^2 Sigma_l for the frames tracked against it, with
   // weighting.line_noise estimated (the previous frame's EstimateLineNoiseScale); 0: Sigma_l

@@ -175,9 +175,7 @@ WindowedBAProblem PhotometricLineWindowBuilder::Build(const WindowedBAWindow& wi
 
   // eq. 5's sigma_I: tracking's estimate where weighting.intensity_noise is estimated.
   WeightingOptions weighting = options_.weighting;
-  if (weighting.intensity_noise == NoiseSource::kEstimated && window.intensity_noise_sigma > 0.0) {
-    weighting.sigma_intensity = window.intensity_noise_sigma;
-  }
+  weighting.sigma_intensity = IntensityNoiseSigma(weighting, window.intensity_noise_sigma);
   ceres::LossFunction* loss = nullptr;
   if (std::unique_ptr<ceres::LossFunction> made = MakeLossFunction(weighting)) {
     loss = problem.AddLossFunction(std::move(made));
