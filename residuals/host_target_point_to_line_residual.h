@@ -51,6 +51,8 @@ class HostTargetPointToLineResidual : public ceres::SizedCostFunction<1, 7, 7, 1
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
+  double sqrt_info() const { return sqrt_info_; }
+
  private:
   const PinholeCamera camera_;
   const Eigen::Vector3d ray_in_host_;

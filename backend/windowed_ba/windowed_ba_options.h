@@ -92,6 +92,12 @@ struct WindowedBAOptions {
   // the inputs' scale, so they trade off against the baseline prior when input poses and depths
   // disagree in scale. 0: no prior (DSO).
   double idepth_prior_scale = 1.0;
+  // Whether a row's weight carries the depth filter's variance V: eq. 5's (g^T J_d)^2 V and eq.
+  // 6's l^T Sigma_x' l, as in tracking, where the depth is a constant. Here the inverse depth is
+  // a variable with V in its prior, so a row's own noise is sigma_I (eq. 5) or the line's
+  // Sigma_l (eq. 6); true counts V twice and down-weights exactly the rows that constrain d
+  // (docs/windowed_ba.md, "Weights").
+  bool depth_variance_in_weights = false;
   // Point-to-line rows (eq. 3) for selected points on edges with a line observation in another
   // window keyframe (off: photometric only).
   bool lines = true;
@@ -163,6 +169,9 @@ struct WindowedBAOptions {
     v.Field("idepth_prior_scale", &idepth_prior_scale,
             "Prior on each inverse depth: N(input, (scale^2) V), V the depth filter's variance; "
             "0 = none.");
+    v.Field("depth_variance_in_weights", &depth_variance_in_weights,
+            "Rows' weights carry the depth filter's variance (eqs. 5, 6 as in tracking); false "
+            "(default): image noise and line covariance only, V in the depth prior alone.");
     v.Field("lines", &lines, "Point-to-line rows for points on edges with a line observation.");
     v.Field("outlier_energy_factor", &outlier_energy_factor,
             "A photometric target whose energy at the input exceeds this^2 times the window's "

@@ -221,6 +221,7 @@ WindowedBAProblem PhotometricLineWindowBuilder::Build(const WindowedBAWindow& wi
     const WindowedBAKeyframe& host_keyframe = keyframe(host);
     const WindowedBAPoint& point = host_keyframe.points[selected.point_index];
     PendingPoint pending_point{selected, {}, {}};
+    const double weight_idepth_var = options_.depth_variance_in_weights ? point.idepth_var : 0.0;
     for (int target = 0; target < n && photometric; ++target) {
       if (target == host) continue;
       const SE3 target_from_host = world_poses[target] * world_poses[host].Inverse();
@@ -236,7 +237,7 @@ WindowedBAProblem PhotometricLineWindowBuilder::Build(const WindowedBAWindow& wi
         // eq. 5 at the linearisation point; 0 where the row's reprojection is not samplable.
         pixel.sqrt_info =
             PhotometricSqrtInfo(weighting, camera, *keyframe(target).pyramid, 0, target_from_host,
-                                pixel.pixel_in_host, point.idepth, point.idepth_var);
+                                pixel.pixel_in_host, point.idepth, weight_idepth_var);
         if (pixel.sqrt_info > 0.0) pending.pattern.push_back(pixel);
       }
       // A target where part of the pattern falls outside is left out: the rows would switch
@@ -263,7 +264,7 @@ WindowedBAProblem PhotometricLineWindowBuilder::Build(const WindowedBAWindow& wi
         }
         const double sqrt_info =
             LineSqrtInfo(weighting, camera, target_from_host, point.pixel, point.idepth,
-                         point.idepth_var, observation.line_in_target);  // eq. 6
+                         weight_idepth_var, observation.line_in_target);  // eq. 6
         if (sqrt_info > 0.0) {
           pending_point.lines.push_back({target, observation.line_in_target.line, sqrt_info});
         }

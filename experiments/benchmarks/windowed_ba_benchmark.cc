@@ -5,8 +5,9 @@
 // WindowedBAOptions except the arguments: points per window (500, 2000) and the solver (ceres
 // SPARSE_SCHUR, ceres DENSE_SCHUR, gauss_newton with Schur on the inverse depths).
 //   build/experiments/benchmarks/windowed_ba_benchmark
-// BM_WindowedBAPrior: the inverse-depth prior (idepth_prior_scale 0, 1, 10) on the test's window
-// (4 keyframes, 320x240, 800 points, 50 iterations) for simulation seeds 1-5.
+// BM_WindowedBAPrior: the inverse-depth prior (idepth_prior_scale 0, 1, 10) and
+// depth_variance_in_weights (1, 0) on the test's window (4 keyframes, 320x240, 800 points, 50
+// iterations) for simulation seeds 1-5.
 // Counters: points, photometric and line rows, iterations, build and solve ms, and the rotation
 // / translation RMS (deg, mm, after fitting the scale) and median / RMS relative inverse-depth
 // error before and after.
@@ -81,7 +82,8 @@ BENCHMARK(BM_WindowedBAWindow)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3);
 
-// state.range(0): simulation seed; state.range(1): idepth_prior_scale.
+// state.range(0): simulation seed; state.range(1): idepth_prior_scale; state.range(2):
+// depth_variance_in_weights.
 void BM_WindowedBAPrior(benchmark::State& state) {
   WindowedBASimulationOptions simulation_options;
   simulation_options.num_keyframes = 4;
@@ -92,6 +94,7 @@ void BM_WindowedBAPrior(benchmark::State& state) {
   options.max_points = 800;
   options.max_iterations = 50;
   options.idepth_prior_scale = static_cast<double>(state.range(1));
+  options.depth_variance_in_weights = state.range(2) != 0;
   WindowedBAResult result;
   for (auto _ : state) {
     result = RunWindowedBA(simulation.window, options);
@@ -101,7 +104,7 @@ void BM_WindowedBAPrior(benchmark::State& state) {
   state.SetLabel(result.summary.converged ? "" : "not converged");
 }
 BENCHMARK(BM_WindowedBAPrior)
-    ->ArgsProduct({{1, 2, 3, 4, 5}, {0, 1, 10}})
+    ->ArgsProduct({{1, 2, 3, 4, 5}, {0, 1, 10}, {1, 0}})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1);
 
