@@ -92,7 +92,8 @@ TEST(WindowedBATest, ReducesPoseAndDepthErrorFromPerturbedStart) {
 // all five (0.32-0.36% against 0.40-0.49%). Bounds as the default's, and the default's median
 // depth error below this one's.
 TEST(WindowedBATest, DepthVarianceInTheWeightsConvergesToALargerDepthError) {
-  PLDVO_RELEASE_ONLY_ACCURACY_TEST("WindowedBATest.CeresAndGaussNewtonAgreeOnTheSameWindow");
+  PLDVO_RELEASE_ONLY_ACCURACY_TEST(
+      "WindowedBATest.DepthVarianceOutOfTheWeightsLeavesImageAndLineNoise");
   WindowedBASimulationOptions simulation_options;
   simulation_options.num_keyframes = 4;
   const WindowedBASimulation simulation = SimulateWindowedBAWindow(simulation_options);
@@ -424,8 +425,8 @@ std::vector<double> LineSqrtInfos(const WindowedBAProblem& problem) {
 
 // depth_variance_in_weights false (default): the inverse depth is a variable with V in its prior
 // only, so a photometric row weighs 1 / (sqrt(2) sigma_I) (eq. 5 without (g^T J_d)^2 V) and a line
-// row x'^T Sigma_l x' alone (eq. 6 without l^T Sigma_x' l): the same rows, each at least as heavy
-// as with V, most strictly heavier.
+// row's variance is x'^T Sigma_l x' alone (eq. 6 without l^T Sigma_x' l): the same rows, each at
+// least as heavy as with V, most strictly heavier.
 TEST(WindowedBATest, DepthVarianceOutOfTheWeightsLeavesImageAndLineNoise) {
   const WindowedBASimulation simulation = SmallWindow();
   WindowedBAOptions options;
