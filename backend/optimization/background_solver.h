@@ -7,6 +7,7 @@
 // problems are pending, the oldest pending one is dropped (a newer one supersedes it), and at
 // most max_queue unpolled results are kept (oldest dropped). A solve that throws gives the result
 // of on_error(what). Result has a `long sequence` member, set to the submission number.
+// on_start, when given, runs first on the worker thread (e.g. to lower its priority).
 #ifndef PLDVO_BACKEND_OPTIMIZATION_BACKGROUND_SOLVER_H_
 #define PLDVO_BACKEND_OPTIMIZATION_BACKGROUND_SOLVER_H_
 
@@ -28,6 +29,7 @@ class BackgroundSolver {
   using Solve = std::function<Result(const Problem&)>;
   using OnError = std::function<Result(const std::string& what)>;
   using ResultCallback = std::function<void(const Result&)>;
+  using OnStart = std::function<void()>;
 
   struct Statistics {
     long submitted = 0;
@@ -37,11 +39,13 @@ class BackgroundSolver {
   };
 
   // Starts the worker; max_queue >= 1.
-  BackgroundSolver(int max_queue, Solve solve, OnError on_error, ResultCallback callback = nullptr)
+  BackgroundSolver(int max_queue, Solve solve, OnError on_error, ResultCallback callback = nullptr,
+                   OnStart on_start = nullptr)
       : max_queue_(max_queue),
         solve_(std::move(solve)),
         on_error_(std::move(on_error)),
         callback_(std::move(callback)),
+        on_start_(std::move(on_start)),
         worker_(&BackgroundSolver::Run, this) {}
   // Finishes the problem being solved, discards pending ones, joins the worker.
   ~BackgroundSolver() {
@@ -94,6 +98,7 @@ class BackgroundSolver {
 
  private:
   void Run() {
+    if (on_start_) on_start_();
     for (;;) {
       std::pair<long, Problem> job;
       {
@@ -135,6 +140,7 @@ class BackgroundSolver {
   const Solve solve_;
   const OnError on_error_;
   const ResultCallback callback_;
+  const OnStart on_start_;
   mutable std::mutex mutex_;
   std::condition_variable work_available_;
   std::condition_variable idle_;

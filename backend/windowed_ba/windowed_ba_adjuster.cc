@@ -1,8 +1,12 @@
 #include "backend/windowed_ba/windowed_ba_adjuster.h"
 
+#include <glog/logging.h>
+
 #include <stdexcept>
 #include <string>
 #include <utility>
+
+#include "backend/optimization/thread_priority.h"
 
 namespace pldvo {
 namespace {
@@ -26,6 +30,11 @@ WindowedBundleAdjuster::WindowedBundleAdjuster(const WindowedBAOptions& options)
             WindowedBAResult result;
             result.summary.message = what;
             return result;
+          },
+          nullptr,
+          [this] {
+            const std::string error = SetCurrentThreadPriority(options_.worker_priority);
+            if (!error.empty()) LOG(WARNING) << "windowed BA worker_priority: " << error;
           }) {}
 
 long WindowedBundleAdjuster::Submit(WindowedBAWindow window) {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "backend/optimization/ba_linear_solver.h"
+#include "backend/optimization/thread_priority.h"
 #include "backend/windowed_ba/leaving_keyframe.h"
 #include "core/options.h"
 #include "residuals/affine_brightness.h"
@@ -133,6 +134,9 @@ struct WindowedBAOptions {
   // Windows waiting in WindowedBundleAdjuster's queue (odometry with the mapping thread); a new
   // one beyond this drops the oldest pending one (a newer window supersedes it).
   int max_queue = 2;
+  // Scheduling priority of the worker thread: idle leaves the cores to tracking and mapping
+  // whenever they want them (the BA then lags and more windows are dropped); normal competes.
+  ThreadPriority worker_priority = ThreadPriority::kIdle;
   // Odometry: the current keyframe's depth-filter hypotheses are shifted by the optimised
   // points' corrections (DepthMapper::ApplyIdepthCorrections); false: poses only.
   bool depth_feedback = true;
@@ -196,6 +200,9 @@ struct WindowedBAOptions {
     v.Field("num_threads", &num_threads, "Ceres threads per solve.");
     v.Field("max_queue", &max_queue,
             "Pending windows in the worker's queue (oldest dropped; default 2).");
+    v.Choice("worker_priority", &worker_priority, ThreadPriorityNames(),
+             "Worker thread: idle (default; runs on cores tracking and mapping leave), low "
+             "(nice 19) or normal.");
     v.Field("depth_feedback", &depth_feedback,
             "Shift the current keyframe's depth-filter hypotheses by the optimised points' "
             "corrections (default true); false: poses only.");
