@@ -356,6 +356,10 @@ int RefinePhotometrically(const std::vector<cv::Mat>& images, const SemiDenseDep
   options.max_points = kPhotometricPoints * options.window;  // the budget is split per frame
   options.lines = false;
   options.idepth_prior_scale = 0.0;
+  // Set here, not inherited from the BA's defaults, which would move every two-view start when
+  // they change (docs/bootstrap.md). With no depth prior V enters once: points whose depth is
+  // uncertain weigh less (eq. 5).
+  options.depth_variance_in_weights = true;
   options.outlier_energy_factor = outlier_factor;
   options.max_iterations = kPhotometricIterations;
   const WindowedBAResult result = RunWindowedBA(window, options);
