@@ -119,7 +119,7 @@ const std::map<std::string, std::function<void(const OdometryConfig&)>>& Cases()
          ExpectExtras(c, true, "points_lines_ba");
          EXPECT_FALSE(c.backend.edge_ba.enabled);
          EXPECT_TRUE(c.backend.windowed_ba.enabled);
-         EXPECT_EQ(c.backend.windowed_ba.window, 7);
+         EXPECT_EQ(c.backend.windowed_ba.window, 10);
          EXPECT_EQ(c.backend.windowed_ba.max_points, 2000);
          EXPECT_EQ(c.backend.windowed_ba.max_iterations, 20);
          EXPECT_TRUE(c.backend.windowed_ba.lines);
