@@ -298,7 +298,8 @@ int RunAblate(const CommandContext& context) {
     std::ofstream csv(out + "/results.csv");
     csv << "dataset,config,status,frames,tracked,keyframes,lost_events,rpe_cm_s,rpe_deg_s,ate_m,"
            "coverage,scale_drift,ms_median_tracking_thread,ms_median_total,init_seed,dir,"
-           "scale_segments,motion_direction_error_deg_median,motion_rotation_ratio\n";
+           "scale_segments,motion_direction_error_deg_median,motion_rotation_ratio,"
+           "reanchored_rpe_cm_s,reanchored_rpe_deg_s,keyframes_ate_m_ba\n";
     for (const Pair& pair : pairs) {
       const nlohmann::json& s = summaries[pair.index];
       auto integer = [&](const char* key) {
@@ -307,6 +308,13 @@ int RunAblate(const CommandContext& context) {
       };
       const nlohmann::json ms =
           s.is_object() && s.contains("ms_median") ? s["ms_median"] : nlohmann::json();
+      // The windowed BA's re-anchored trajectory (trajectory_ba.txt); a run without the BA has
+      // only trajectory.txt, so BA and no-BA configs compare on one column.
+      const bool ba = s.is_object() && s.contains("windowed_ba") &&
+                      s["windowed_ba"].contains("reanchored_rpe_cm_s");
+      const nlohmann::json& reanchored = ba ? s["windowed_ba"] : s;
+      const char* rpe_key = ba ? "reanchored_rpe_cm_s" : "rpe_cm_s";
+      const char* rpe_deg_key = ba ? "reanchored_rpe_deg_s" : "rpe_deg_s";
       csv << dataset_names[pair.dataset] << "," << config_names[pair.config] << ","
           << statuses[pair.index] << "," << integer("frames") << "," << integer("tracked") << ","
           << integer("keyframes") << "," << integer("lost_events") << ","
@@ -317,7 +325,10 @@ int RunAblate(const CommandContext& context) {
           << "," << (repeats > 1 ? std::to_string(pair.repeat) : std::string()) << "," << pair.dir
           << "," << integer("scale_segments") << ","
           << Fixed(JsonNumber(s, "motion_direction_error_deg_median"), 2) << ","
-          << Fixed(JsonNumber(s, "motion_rotation_ratio"), 4) << "\n";
+          << Fixed(JsonNumber(s, "motion_rotation_ratio"), 4) << ","
+          << Fixed(JsonNumber(reanchored, rpe_key), 4) << ","
+          << Fixed(JsonNumber(reanchored, rpe_deg_key), 4) << ","
+          << Fixed(ba ? JsonNumber(reanchored, "keyframes_ate_m_ba") : std::nan(""), 5) << "\n";
     }
   }
   {

@@ -74,6 +74,7 @@ std::vector<std::vector<std::string>> CsvRows(const fs::path& path) {
     std::stringstream stream(line);
     std::string field;
     while (std::getline(stream, field, ',')) fields.push_back(field);
+    if (!line.empty() && line.back() == ',') fields.push_back("");  // getline drops the last
     rows.push_back(fields);
   }
   return rows;
@@ -538,12 +539,12 @@ TEST(AblateCommandTest, TinyGridWritesTablesAndPlot) {
                       0),
             0u)
       << csv;
-  // The scale segments, the motion direction error and the rotation ratio close the header
-  // (appended: scripts read the columns by position), and neither run of this short sequence
-  // re-initialises.
-  EXPECT_NE(
-      csv.find(",dir,scale_segments,motion_direction_error_deg_median,motion_rotation_ratio\n"),
-      std::string::npos)
+  // The scale segments, the motion direction error, the rotation ratio and the windowed BA's
+  // re-anchored figures close the header (appended: scripts read the columns by position), and
+  // neither run of this short sequence re-initialises.
+  EXPECT_NE(csv.find(",dir,scale_segments,motion_direction_error_deg_median,motion_rotation_ratio,"
+                     "reanchored_rpe_cm_s,reanchored_rpe_deg_s,keyframes_ate_m_ba\n"),
+            std::string::npos)
       << csv;
   EXPECT_NE(csv.find("/lowtex__sdvo,1,"), std::string::npos) << csv;
   // results.md: the RPE table with one row for the sequence and a column per config.
@@ -654,13 +655,17 @@ TEST(AblateCommandTest, ShardsThenCollectGiveTheResultsOfOneRun) {
   ASSERT_EQ(expected.size(), num_runs);
   ASSERT_EQ(actual.size(), expected.size());
   // Columns: ..., 12 ms_median_tracking_thread, 13 ms_median_total, 14 init_seed, 15 dir,
-  // 16 scale_segments, 17 motion_direction_error_deg_median, 18 motion_rotation_ratio: all but
-  // the times and the run folder must agree.
+  // 16 scale_segments, 17 motion_direction_error_deg_median, 18 motion_rotation_ratio,
+  // 19-21 re-anchored RPE, rotation RPE, keyframe ATE: all but the times and the run folder must
+  // agree.
   for (size_t row = 0; row < expected.size(); ++row) {
-    ASSERT_EQ(actual[row].size(), 19u);
-    ASSERT_EQ(expected[row].size(), 19u);
+    ASSERT_EQ(actual[row].size(), 22u);
+    ASSERT_EQ(expected[row].size(), 22u);
     EXPECT_EQ(expected[row][2], "ok") << "row " << row;
-    for (size_t column = 0; column < 19; ++column) {
+    // Without the windowed BA the re-anchored RPE is trajectory.txt's, the keyframe ATE empty.
+    EXPECT_EQ(expected[row][19], expected[row][7]) << "row " << row;
+    EXPECT_EQ(expected[row][21], "") << "row " << row;
+    for (size_t column = 0; column < 22; ++column) {
       if (column == 12 || column == 13 || column == 15) continue;
       EXPECT_EQ(actual[row][column], expected[row][column])
           << "row " << row << " column " << column;
