@@ -357,7 +357,11 @@ LineDepthFusionStats DepthMapper::FuseLineDepths(const std::vector<KeyframeLine>
 }
 
 int DepthMapper::ApplyIdepthCorrections(const std::vector<IdepthCorrection>& corrections,
-                                        const SE3* new_from_old) {
+                                        const SE3* new_from_old, double idepth_scale) {
+  if (!(idepth_scale > 0.0) || !std::isfinite(idepth_scale)) {
+    throw std::invalid_argument("ApplyIdepthCorrections: idepth_scale must be positive, got " +
+                                std::to_string(idepth_scale));
+  }
   int applied = 0;
   std::vector<char> corrected(map_.num_pixels(), 0);
   for (const IdepthCorrection& correction : corrections) {
@@ -369,9 +373,11 @@ int DepthMapper::ApplyIdepthCorrections(const std::vector<IdepthCorrection>& cor
     map_.SetIdepth(i, idepth);
     ++applied;
   }
-  if (new_from_old == nullptr) return applied;
-  const Eigen::Matrix3d rotation = new_from_old->rotation_matrix();
-  const Eigen::Vector3d translation = new_from_old->translation();
+  if (new_from_old == nullptr && idepth_scale == 1.0) return applied;
+  const Eigen::Matrix3d rotation =
+      new_from_old != nullptr ? new_from_old->rotation_matrix() : Eigen::Matrix3d::Identity();
+  const Eigen::Vector3d translation =
+      new_from_old != nullptr ? new_from_old->translation() : Eigen::Vector3d::Zero();
   for (int i = 0; i < map_.num_pixels(); ++i) {
     if (corrected[i] || !map_.valid(i)) continue;
     const double idepth = map_.idepth(i);
@@ -379,9 +385,9 @@ int DepthMapper::ApplyIdepthCorrections(const std::vector<IdepthCorrection>& cor
     const double c = rotation.row(2).dot(camera_.Unproject(pixel));
     const double denominator = c + translation.z() * idepth;
     if (!(denominator > 0.0)) continue;
-    const double moved = idepth / denominator;
+    const double moved = idepth_scale * idepth / denominator;
     if (!(moved > 0.0) || !(moved <= options_.max_idepth)) continue;
-    const double jacobian = c / (denominator * denominator);
+    const double jacobian = idepth_scale * c / (denominator * denominator);
     map_.SetIdepthAndVar(i, moved, jacobian * jacobian * map_.idepth_var(i));
     ++applied;
   }

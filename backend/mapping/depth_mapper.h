@@ -132,11 +132,13 @@ class DepthMapper {
   //   propagated from), every other valid hypothesis re-expressed in the moved frame at its pixel:
   //   with r = K^-1 (x; 1) and c = (R r)_z, the point r / d becomes R r / d + t, so
   //   d' = d / (c + t_z d) and V' = (c / (c + t_z d)^2)^2 V (first order); the pixel's shift,
-  //   below a pixel for the small corrections of a window, is not applied.
+  //   below a pixel for the small corrections of a window, is not applied;
+  // - with `idepth_scale` != 1 (the BA's scale against the map's, WindowedBAKeyframes::Apply),
+  //   every other valid hypothesis then scaled: d' = s d, V' = s^2 V (the map at the BA's scale).
   // A result that is non-positive, above options.max_idepth or on an invalid pixel is skipped.
   // Returns the number of hypotheses changed.
   int ApplyIdepthCorrections(const std::vector<IdepthCorrection>& corrections,
-                             const SE3* new_from_old = nullptr);
+                             const SE3* new_from_old = nullptr, double idepth_scale = 1.0);
 
   // A copy of the filter state with inverse-variance smoothing (if smooth) and the 3D line
   // regularisation of the keyframe's edges (if line_regularize).

@@ -237,7 +237,8 @@ void MappingWorker::Run(const MappingJob& job) {
           outliers = stats.outliers;
         } else {
           corrected = mapper_.ApplyIdepthCorrections(
-              job.idepth_corrections, job.move_keyframe ? &job.new_from_old : nullptr);
+              job.idepth_corrections, job.move_keyframe ? &job.new_from_old : nullptr,
+              job.idepth_scale);
         }
         std::lock_guard<std::mutex> lock(mutex_);
         line_depths_fused_ += fused;

@@ -93,10 +93,11 @@ struct MappingJob {
   std::vector<KeyframeLine> line_depths;
   // kIdepthCorrections: the windowed BA's inverse-depth corrections of keyframe_id's hypotheses
   // and, with move_keyframe, new_from_old is the keyframe's frame moved relative to the keyframe
-  // it was propagated from (DepthMapper::ApplyIdepthCorrections); ignored when keyframe_id is no
-  // longer current.
+  // it was propagated from, and the other hypotheses are scaled by idepth_scale
+  // (DepthMapper::ApplyIdepthCorrections); ignored when keyframe_id is no longer current.
   std::vector<IdepthCorrection> idepth_corrections;
   bool move_keyframe = false;
+  double idepth_scale = 1.0;
 };
 
 class MappingWorker {

@@ -310,7 +310,8 @@ void Odometry::ApplyWindowedBA(const WindowedBAResult& result) {
       windowed_ba_keyframes_->WorldFromPreviousKeyframe(keyframe_.id, &world_from_previous);
   const SE3 kf_from_previous_before = keyframe_.world_from_kf.Inverse() * world_from_previous;
   std::vector<IdepthCorrection> corrections;
-  if (!windowed_ba_keyframes_->Apply(result, keyframe_.id, &corrections)) return;
+  double idepth_scale = 1.0;
+  if (!windowed_ba_keyframes_->Apply(result, keyframe_.id, &corrections, &idepth_scale)) return;
   ++stats_.windowed_ba_applied;
   SE3 world_from_kf;
   if (windowed_ba_keyframes_->WorldFromKeyframe(keyframe_.id, &world_from_kf)) {
@@ -335,7 +336,11 @@ void Odometry::ApplyWindowedBA(const WindowedBAResult& result) {
     job.move_keyframe = true;
     job.new_from_old = kf_from_previous_after * kf_from_previous_before.Inverse();
   }
-  if (job.idepth_corrections.empty() && !job.move_keyframe) return;
+  if (config_.backend.windowed_ba.scale_current_map && idepth_scale != 1.0) {
+    job.idepth_scale = idepth_scale;
+    ScaleCurrentKeyframeMap(idepth_scale);
+  }
+  if (job.idepth_corrections.empty() && !job.move_keyframe && job.idepth_scale == 1.0) return;
   ++stats_.windowed_ba_idepth_jobs;
   mapper_->Submit(std::move(job));
 }
@@ -380,6 +385,15 @@ void Odometry::PollEdgeBA() {
 void Odometry::MoveCurrentKeyframe(const SE3& world_from_kf) {
   world_from_last_good_ = world_from_kf * keyframe_.world_from_kf.Inverse() * world_from_last_good_;
   keyframe_.world_from_kf = world_from_kf;
+}
+
+void Odometry::ScaleCurrentKeyframeMap(double idepth_scale) {
+  // Inverse depths times s: lengths in the keyframe's frame divided by s, so the last tracked
+  // frame's translation relative to it and the motion model's translation too.
+  const SE3 kf_from_last = keyframe_.world_from_kf.Inverse() * world_from_last_good_;
+  world_from_last_good_ = keyframe_.world_from_kf * SE3(kf_from_last.rotation_matrix(),
+                                                        kf_from_last.translation() / idepth_scale);
+  velocity_ = SE3(velocity_.rotation_matrix(), velocity_.translation() / idepth_scale);
 }
 
 void Odometry::ApplyEdgeBA(const EdgeBAResult& result) {

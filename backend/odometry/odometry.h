@@ -229,6 +229,9 @@ class Odometry {
   // A bundle adjustment moved the current keyframe to world_from_kf: the last good frame, tracked
   // against it (or it), moves rigidly with it, so the motion model (relative) stays valid.
   void MoveCurrentKeyframe(const SE3& world_from_kf);
+  // The current keyframe's map goes to the BA's scale (inverse depths times idepth_scale): the
+  // last good frame's translation relative to the keyframe and the motion model's follow it.
+  void ScaleCurrentKeyframeMap(double idepth_scale);
   void NotifyRetired(const KeyframeMap& map);
   // A new keyframe's first published map: a fresh random map on a re-initialisation keyframe
   // loses the scale (scale_lost_).

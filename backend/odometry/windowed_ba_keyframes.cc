@@ -182,7 +182,9 @@ void WindowedBAKeyframes::Remember(long sequence, const WindowedBAWindow& window
 }
 
 bool WindowedBAKeyframes::Apply(const WindowedBAResult& result, int corrections_id,
-                                std::vector<IdepthCorrection>* corrections_of) {
+                                std::vector<IdepthCorrection>* corrections_of,
+                                double* idepth_scale_of) {
+  if (idepth_scale_of != nullptr) *idepth_scale_of = 1.0;
   const auto found = submitted_.find(result.sequence);
   if (found == submitted_.end()) return false;
   const Snapshot snapshot = std::move(found->second);
@@ -223,6 +225,7 @@ bool WindowedBAKeyframes::Apply(const WindowedBAResult& result, int corrections_
     }
     const std::vector<WindowedBAPoint>& before = *submitted->second;
     auto points = std::make_shared<std::vector<WindowedBAPoint>>(before);
+    std::vector<double> ratios;
     for (const WindowedBAResultPoint* point : host->second) {
       if (point->point_index < 0 || point->point_index >= static_cast<int>(before.size()) ||
           !(point->idepth > 0.0) || !std::isfinite(point->idepth)) {
@@ -230,13 +233,20 @@ bool WindowedBAKeyframes::Apply(const WindowedBAResult& result, int corrections_
       }
       const WindowedBAPoint& old_point = before[point->point_index];
       (*points)[point->point_index].idepth = point->idepth;
-      if (corrections_of != nullptr && keyframe.record.id == corrections_id) {
+      if (keyframe.record.id != corrections_id) continue;
+      if (corrections_of != nullptr) {
         corrections_of->push_back({static_cast<int>(old_point.pixel.y()) * camera_.width +
                                        static_cast<int>(old_point.pixel.x()),
                                    point->idepth - old_point.idepth});
       }
+      if (old_point.idepth > 0.0) ratios.push_back(point->idepth / old_point.idepth);
     }
     keyframe.points = std::move(points);
+    if (idepth_scale_of != nullptr && static_cast<int>(ratios.size()) >= kMinScalePoints) {
+      const auto middle = ratios.begin() + ratios.size() / 2;
+      std::nth_element(ratios.begin(), middle, ratios.end());
+      *idepth_scale_of = *middle;
+    }
   }
   if (result.prior != nullptr) prior_ = result.prior;
   return true;

@@ -87,9 +87,12 @@ class WindowedBAKeyframes {
   // produced poses and did not raise the cost; its prior (if any) goes with the next snapshots.
   // Returns false (and changes nothing) otherwise.
   // Forgets that snapshot and every older one. `corrections_of` (may be null) receives the
-  // inverse-depth corrections of keyframe `corrections_id`'s optimised points.
+  // inverse-depth corrections of keyframe `corrections_id`'s optimised points, `idepth_scale_of`
+  // (may be null) the median of their refined / submitted inverse depths: the BA's scale against
+  // the map's (1 with fewer than kMinScalePoints of them).
+  static constexpr int kMinScalePoints = 20;
   bool Apply(const WindowedBAResult& result, int corrections_id,
-             std::vector<IdepthCorrection>* corrections_of);
+             std::vector<IdepthCorrection>* corrections_of, double* idepth_scale_of = nullptr);
   bool WorldFromKeyframe(int id, SE3* world_from_kf) const;
   // The pose of the keyframe recorded just before `id`; false when there is none.
   bool WorldFromPreviousKeyframe(int id, SE3* world_from_previous) const;

@@ -144,6 +144,11 @@ struct WindowedBAOptions {
   // as the BA moved it relative to the keyframe its map was propagated from (off: only the
   // optimised points change; docs/windowed_ba.md compares the two).
   bool warp_current_map = false;
+  // ... and with depth_feedback, the current keyframe's other hypotheses (and tracking's
+  // translation relative to it) scaled to the BA's scale: the median refined / submitted inverse
+  // depth of its optimised points (off: the map keeps its own scale and the trajectory jumps at
+  // every keyframe by the difference; docs/windowed_ba.md).
+  bool scale_current_map = false;
 
   template <class Visitor>
   void VisitFields(Visitor& v) {
@@ -209,6 +214,10 @@ struct WindowedBAOptions {
     v.Field("warp_current_map", &warp_current_map,
             "depth_feedback: also re-express the current keyframe's other hypotheses in its "
             "frame as moved by the BA relative to its propagation source (default false).");
+    v.Field("scale_current_map", &scale_current_map,
+            "depth_feedback: also scale the current keyframe's other hypotheses and tracking's "
+            "translation to the BA's scale (median refined / submitted inverse depth; default "
+            "false).");
   }
   // "" when valid, otherwise what is wrong (names the key; an unknown problem_builder lists the
   // registered ones).
