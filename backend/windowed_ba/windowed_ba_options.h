@@ -146,8 +146,8 @@ struct WindowedBAOptions {
   bool warp_current_map = false;
   // ... and with depth_feedback, the current keyframe's other hypotheses (and tracking's
   // translation relative to it) scaled to the BA's scale: the median refined / submitted inverse
-  // depth of its optimised points (off: the map keeps its own scale and the trajectory jumps at
-  // every keyframe by the difference; docs/windowed_ba.md).
+  // depth of its optimised points (off: the map keeps its own scale; docs/windowed_ba.md measures
+  // both).
   bool scale_current_map = false;
 
   template <class Visitor>
