@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "core/statistics.h"
+
 namespace pldvo {
 namespace {
 
@@ -243,9 +245,7 @@ bool WindowedBAKeyframes::Apply(const WindowedBAResult& result, int corrections_
     }
     keyframe.points = std::move(points);
     if (idepth_scale_of != nullptr && static_cast<int>(ratios.size()) >= kMinScalePoints) {
-      const auto middle = ratios.begin() + ratios.size() / 2;
-      std::nth_element(ratios.begin(), middle, ratios.end());
-      *idepth_scale_of = *middle;
+      *idepth_scale_of = UpperMedian(std::move(ratios));
     }
   }
   if (result.prior != nullptr) prior_ = result.prior;
