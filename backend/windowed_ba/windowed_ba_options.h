@@ -93,6 +93,11 @@ struct WindowedBAOptions {
   // the inputs' scale, so they trade off against the baseline prior when input poses and depths
   // disagree in scale. 0: no prior (DSO).
   double idepth_prior_scale = 1.0;
+  // A robust loss on each inverse-depth prior's whitened residual (in sigmas; threshold
+  // idepth_prior_loss_threshold): a filter hypothesis the rows contradict by many sigmas (a wrong
+  // stereo or line match, confident) then stops pulling the window's scale. none: Gaussian.
+  RobustLossKind idepth_prior_loss = RobustLossKind::kNone;
+  double idepth_prior_loss_threshold = 2.0;
   // Whether a row's weight carries the depth filter's variance V: eq. 5's (g^T J_d)^2 V and eq.
   // 6's l^T Sigma_x' l, as in tracking, where the depth is a constant. Here the inverse depth is
   // a variable with V in its prior, so a row's own noise is sigma_I (eq. 5) or the line's
@@ -178,6 +183,10 @@ struct WindowedBAOptions {
     v.Field("idepth_prior_scale", &idepth_prior_scale,
             "Prior on each inverse depth: N(input, (scale^2) V), V the depth filter's variance; "
             "0 = none.");
+    v.Choice("idepth_prior_loss", &idepth_prior_loss, RobustLossKindNames(),
+             "Robust loss on the inverse-depth priors: none (default), huber or cauchy.");
+    v.Field("idepth_prior_loss_threshold", &idepth_prior_loss_threshold,
+            "Threshold of idepth_prior_loss, in sigmas of the prior (default 2).");
     v.Field("depth_variance_in_weights", &depth_variance_in_weights,
             "Rows' weights carry the depth filter's variance (eqs. 5, 6 as in tracking); false "
             "(default): image noise and line covariance only, V in the depth prior alone.");

@@ -182,6 +182,14 @@ WindowedBAProblem PhotometricLineWindowBuilder::Build(const WindowedBAWindow& wi
   }
   ceres::LossFunction* loss_inside = loss_in_problem_ ? nullptr : loss;
   ceres::LossFunction* loss_outside = loss_in_problem_ ? loss : nullptr;
+  // The inverse-depth priors' own loss (idepth_prior_loss, in sigmas of the prior).
+  WeightingOptions prior_weighting;
+  prior_weighting.robust_loss = options_.idepth_prior_loss;
+  prior_weighting.robust_threshold = options_.idepth_prior_loss_threshold;
+  ceres::LossFunction* prior_loss = nullptr;
+  if (std::unique_ptr<ceres::LossFunction> made = MakeLossFunction(prior_weighting)) {
+    prior_loss = problem.AddLossFunction(std::move(made));
+  }
   const bool photometric = UsesPhotometric(weighting.policy);
   const bool lines = options_.lines && UsesLines(weighting.policy);
 
@@ -309,7 +317,7 @@ WindowedBAProblem PhotometricLineWindowBuilder::Build(const WindowedBAWindow& wi
       const int block = problem.AddResidualBlock(
           std::make_unique<ceres::NormalPrior>(ceres::Matrix::Constant(1, 1, 1.0 / sigma),
                                                ceres::Vector::Constant(1, point.idepth)),
-          nullptr, {idepth});
+          prior_loss, {idepth});
       if (host == 0) out.oldest_host_blocks.push_back(block);
     }
     kept_points.push_back(selected);
@@ -354,6 +362,9 @@ std::string WindowedBAOptions::Check() const {
   }
   if (!(idepth_prior_scale >= 0.0) || !std::isfinite(idepth_prior_scale)) {
     return "idepth_prior_scale must be >= 0 and finite";
+  }
+  if (!(idepth_prior_loss_threshold > 0.0) || !std::isfinite(idepth_prior_loss_threshold)) {
+    return "idepth_prior_loss_threshold must be positive and finite";
   }
   if (!(brightness_prior_sigma_a > 0.0) || !(brightness_prior_sigma_b > 0.0) ||
       !std::isfinite(brightness_prior_sigma_a) || !std::isfinite(brightness_prior_sigma_b)) {
