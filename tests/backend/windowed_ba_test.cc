@@ -95,6 +95,32 @@ TEST(WindowedBATest, ReducesPoseAndDepthErrorFromPerturbedStart) {
   EXPECT_LT(depth_errors[0], depth_errors[1]);
 }
 
+// The default window (4 keyframes) with every `every`-th point's input inverse depth times
+// `factor`, a wrong depth the filter is confident about (its variance stays (2.5%)^2); `wrong`
+// gets each one's (keyframe id, point index).
+WindowedBASimulation WindowWithWrongDepths(size_t every, double factor,
+                                           std::set<std::pair<int, int>>* wrong) {
+  WindowedBASimulationOptions simulation_options;
+  simulation_options.num_keyframes = 4;
+  WindowedBASimulation simulation = SimulateWindowedBAWindow(simulation_options);
+  for (WindowedBAKeyframe& keyframe : simulation.window.keyframes) {
+    for (size_t i = 0; i < keyframe.points.size(); i += every) {
+      keyframe.points[i].idepth *= factor;
+      wrong->insert({keyframe.id, static_cast<int>(i)});
+    }
+  }
+  return simulation;
+}
+
+// The options both wrong-depth tests solve that window with.
+WindowedBAOptions WrongDepthWindowOptions() {
+  WindowedBAOptions options;
+  options.window = 4;
+  options.max_points = 800;
+  options.max_iterations = 50;
+  return options;
+}
+
 // DSO's outlier test (outlier_energy_factor): the default window with every 8th point's input
 // inverse depth 40% too large (a wrong depth the filter is confident about: its variance stays
 // (2.5%)^2), solved without and with the test (factor 2). Measured: without, 93 wrong and 697
@@ -107,20 +133,9 @@ TEST(WindowedBATest, ReducesPoseAndDepthErrorFromPerturbedStart) {
 // 5% of the right ones lost.
 TEST(WindowedBATest, OutlierTestLeavesOutWrongDepths) {
   PLDVO_RELEASE_ONLY_ACCURACY_TEST("WindowedBATest.ProblemHasTheGaugeAndCovarianceWeights");
-  WindowedBASimulationOptions simulation_options;
-  simulation_options.num_keyframes = 4;
-  WindowedBASimulation simulation = SimulateWindowedBAWindow(simulation_options);
   std::set<std::pair<int, int>> wrong;
-  for (WindowedBAKeyframe& keyframe : simulation.window.keyframes) {
-    for (size_t i = 0; i < keyframe.points.size(); i += 8) {
-      keyframe.points[i].idepth *= 1.4;
-      wrong.insert({keyframe.id, static_cast<int>(i)});
-    }
-  }
-  WindowedBAOptions options;
-  options.window = 4;
-  options.max_points = 800;
-  options.max_iterations = 50;
+  const WindowedBASimulation simulation = WindowWithWrongDepths(8, 1.4, &wrong);
+  WindowedBAOptions options = WrongDepthWindowOptions();
   const WindowedBAResult without = RunWindowedBA(simulation.window, options);
   options.outlier_energy_factor = 2.0;
   const WindowedBAResult with = RunWindowedBA(simulation.window, options);
@@ -160,21 +175,10 @@ TEST(WindowedBATest, OutlierTestLeavesOutWrongDepths) {
 // 33% and 30%: their rows alone barely move them in 50 iterations). Bounds: rotation halved,
 // translation to 0.6x. Breaking it: the loss left off the prior blocks makes both runs equal.
 TEST(WindowedBATest, RobustDepthPriorLetsTheRowsOverruleWrongDepths) {
-  PLDVO_RELEASE_ONLY_ACCURACY_TEST("WindowedBATest.OutlierTestLeavesOutWrongDepths");
-  WindowedBASimulationOptions simulation_options;
-  simulation_options.num_keyframes = 4;
-  WindowedBASimulation simulation = SimulateWindowedBAWindow(simulation_options);
+  PLDVO_RELEASE_ONLY_ACCURACY_TEST("WindowedBATest.CeresAndGaussNewtonAgreeOnTheSameWindow");
   std::set<std::pair<int, int>> wrong;
-  for (WindowedBAKeyframe& keyframe : simulation.window.keyframes) {
-    for (size_t i = 0; i < keyframe.points.size(); i += 4) {
-      keyframe.points[i].idepth *= 0.6;
-      wrong.insert({keyframe.id, static_cast<int>(i)});
-    }
-  }
-  WindowedBAOptions options;
-  options.window = 4;
-  options.max_points = 800;
-  options.max_iterations = 50;
+  const WindowedBASimulation simulation = WindowWithWrongDepths(4, 0.6, &wrong);
+  WindowedBAOptions options = WrongDepthWindowOptions();
   const WindowedBAResult gaussian = RunWindowedBA(simulation.window, options);
   options.idepth_prior_loss = RobustLossKind::kHuber;  // threshold 2 sigmas, the default
   const WindowedBAResult robust = RunWindowedBA(simulation.window, options);
