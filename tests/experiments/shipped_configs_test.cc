@@ -1,7 +1,7 @@
 // Every config shipped in experiments/configs/ loads into OdometryConfig and sets the switches
 // its header comment names (a file that silently stopped doing what it says would otherwise run
-// the defaults); every shipped file has its case here. docs/config_keys.md is the key table of
-// `pldvo run --list_config` (DescribeConfig) and must equal it.
+// the defaults); every shipped file has its case here. docs/config_keys.md and _backend.md hold the
+// key table of `pldvo run --list_config` (DescribeConfig), split in two, and must equal it.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -188,18 +188,30 @@ TEST(ShippedConfigsTest, DefaultsArePointsLinesAndPaperSwitchesOffTheExtras) {
   EXPECT_EQ(ConfigToString(Load("points_lines")), ConfigToString(OdometryConfig()));
 }
 
-// docs/config_keys.md: a header, then exactly the table `pldvo run --list_config` prints
-// (regenerate with scripts/config_keys.sh).
-TEST(ConfigKeysDocTest, EqualsTheListConfigTable) {
-  std::ifstream file(fs::path(PLDVO_SOURCE_DIR) / "docs" / "config_keys.md");
-  ASSERT_TRUE(file) << "docs/config_keys.md missing";
+// The key table of a docs page: from its header row "| key | type | default | doc |" on.
+std::string KeyTable(const std::string& page) {
+  std::ifstream file(fs::path(PLDVO_SOURCE_DIR) / "docs" / page);
+  EXPECT_TRUE(file) << "docs/" << page << " missing";
   std::stringstream text;
   text << file.rdbuf();
   const std::string doc = text.str();
   const size_t table = doc.find("| key | type | default | doc |");
-  ASSERT_NE(table, std::string::npos) << "no key table in docs/config_keys.md";
-  EXPECT_EQ(doc.substr(table), DescribeConfig(OdometryConfig()))
-      << "docs/config_keys.md is stale: run scripts/config_keys.sh";
+  EXPECT_NE(table, std::string::npos) << "no key table in docs/" << page;
+  return table == std::string::npos ? std::string() : doc.substr(table);
+}
+
+// docs/config_keys.md and docs/config_keys_backend.md: each a header, then the two halves of the
+// table `pldvo run --list_config` prints, the second half under its own two header rows
+// (regenerate with scripts/config_keys.sh).
+TEST(ConfigKeysDocTest, EqualsTheListConfigTable) {
+  const std::string first = KeyTable("config_keys.md");
+  const std::string second = KeyTable("config_keys_backend.md");
+  const size_t rows = second.find('\n', second.find('\n') + 1);  // after the two header rows
+  ASSERT_NE(rows, std::string::npos);
+  EXPECT_EQ(first + second.substr(rows + 1), DescribeConfig(OdometryConfig()))
+      << "docs/config_keys.md or docs/config_keys_backend.md is stale: run scripts/config_keys.sh";
+  EXPECT_EQ(second.find("| **`odometry`** | section"), rows + 1)
+      << "docs/config_keys_backend.md must start at the odometry section";
 }
 
 }  // namespace
