@@ -47,6 +47,7 @@ void FrameUpdateStats::AddCounts(const FrameUpdateStats& other) {
   line_narrow_prior += other.line_narrow_prior;
   ssd_attempts += other.ssd_attempts;
   ssd_ok += other.ssd_ok;
+  ssd_interval_end += other.ssd_interval_end;
   fused += other.fused;
   created += other.created;
   outliers += other.outliers;
@@ -244,6 +245,13 @@ void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
                                &observation);
     if (status == StereoStatus::kNotUnique || status == StereoStatus::kLargeError) {
       map_.AddBlacklist(index);
+    }
+    if (status == StereoStatus::kIntervalEnd) {
+      ++stats->ssd_interval_end;
+      if (valid && options_.ssd_interval_end == MappingOptions::IntervalEndMinimum::kOutlier) {
+        map_.CountOutlier(index, options_);
+        ++stats->outliers;
+      }
     }
     if (status != StereoStatus::kOk) return;
     ++stats->ssd_ok;

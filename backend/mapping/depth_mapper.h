@@ -58,6 +58,8 @@ struct FrameUpdateStats {
   std::vector<int> dropped_line_matches;
   int ssd_attempts = 0;
   int ssd_ok = 0;
+  // SSD searches whose best lay at an open end of the prior interval (options.ssd_interval_end).
+  int ssd_interval_end = 0;
   int fused = 0;                 // EKF updates
   int created = 0;               // new hypotheses from a full-range search
   int outliers = 0;              // observations rejected by the EKF gate

@@ -90,6 +90,8 @@ const char* StereoStatusName(StereoStatus status) {
       return "not_unique";
     case StereoStatus::kLargeError:
       return "large_error";
+    case StereoStatus::kIntervalEnd:
+      return "interval_end";
     case StereoStatus::kLineIllConditioned:
       return "line_ill_conditioned";
     case StereoStatus::kLineOutOfRange:
@@ -175,8 +177,13 @@ StereoStatus SearchEpipolarSsd(const ImagePyramid& current, const EpipolarGeomet
                                double idepth_min, double idepth_max, const MappingOptions& options,
                                StereoObservation* observation) {
   Eigen::Vector2d p_far, p_near;
+  // Ends of the interval beyond which a match could lie: not the global bounds, nor the current
+  // camera's plane.
+  const bool far_end_open = idepth_min > options.min_idepth;
+  bool near_end_open = idepth_max < options.max_idepth;
   if (!geometry.Project(pixel_in_ref, idepth_min, &p_far)) return StereoStatus::kOutside;
   if (!geometry.Project(pixel_in_ref, idepth_max, &p_near)) {
+    near_end_open = false;
     // The upper bound lies behind the current camera: search up to just before its plane.
     const Eigen::Vector3d a = geometry.InfinityPoint(pixel_in_ref);
     const Eigen::Vector3d& b = geometry.ScaledTranslation();
@@ -249,6 +256,10 @@ StereoStatus SearchEpipolarSsd(const ImagePyramid& current, const EpipolarGeomet
     if (std::abs(k - best) > near_best) second = std::min(second, ssd[k]);
   }
   if (std::sqrt(ssd[best] / 5.0) > options.max_ssd_rms) return StereoStatus::kLargeError;
+  if (options.ssd_interval_end != MappingOptions::IntervalEndMinimum::kAccept &&
+      ((best == 0 && far_end_open) || (best == num_steps - 1 && near_end_open))) {
+    return StereoStatus::kIntervalEnd;
+  }
   if (second < options.ssd_uniqueness_ratio * ssd[best]) return StereoStatus::kNotUnique;
   // Sub-pixel: vertex of the parabola through the neighbouring SSDs.
   double offset = 0.0;

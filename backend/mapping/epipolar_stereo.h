@@ -80,6 +80,8 @@ enum class StereoStatus {
                         // may lie there; the best sampled step is no evidence)
   kNotUnique,           // second-best SSD too close to the best (counts towards the blacklist)
   kLargeError,          // best SSD above max_ssd_rms (counts towards the blacklist)
+  kIntervalEnd,         // the best SSD is at an end of the prior interval that is not a global
+                        // bound (options.ssd_interval_end)
   kLineIllConditioned,  // line-guided: epipolar line and edge nearly parallel
   kLineOutOfRange,      // line-guided: the intersection lies outside the prior interval
 };
@@ -130,7 +132,9 @@ struct StereoObservation {
 // matches"). Every step of the interval must be sampled: when part of it leaves the current
 // image the search returns kTruncated, because the best of the remaining steps is then a wrong
 // match whenever the true one lies outside (under forward motion the bottom rows' matches leave
-// the image first; docs/mapping.md, "Truncated searches").
+// the image first; docs/mapping.md, "Truncated searches"). With options.ssd_interval_end other than
+// accept, a best step at an end of [idepth_min, idepth_max] that is not a global bound returns
+// kIntervalEnd.
 StereoStatus SearchEpipolarSsd(const ImagePyramid& current, const EpipolarGeometry& geometry,
                                const EpipolarPatch& patch, const Eigen::Vector2d& pixel_in_ref,
                                double idepth_min, double idepth_max, const MappingOptions& options,

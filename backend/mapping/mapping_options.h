@@ -17,6 +17,7 @@ struct MappingOptions {
   enum class OutlierModel { kValidityCounter, kInlierRatio };
   enum class LineRegularizationMethod { kRay1d, kPaper2d };
   enum class LineStereoSsd { kFallback, kRefine, kRefineMorePrecise, kFuse, kFirst };
+  enum class IntervalEndMinimum { kAccept, kSkip, kOutlier };
 
   // ---- Pixel selection.
   // A keyframe pixel gets a depth hypothesis when |grad I| (central differences, gray levels per
@@ -68,6 +69,14 @@ struct MappingOptions {
   // Add the spread of the search's other SSD minima, weighted by their likelihood, to the
   // observation variance (docs/mapping.md, "Search step and ambiguous matches").
   bool ssd_ambiguity_variance = true;
+  // An SSD search whose best step is an end of the prior interval (idepth +- search_sigmas sigma)
+  // has not found a minimum: the match may lie beyond that end, and the end's depth is no
+  // evidence. kAccept: fuse it (Engel 2013); kSkip: no observation this frame; kOutlier: count it
+  // as an outlier of the hypothesis (validity_decrement), so that a hypothesis the images keep
+  // contradicting is dropped and searched again over the whole range. Ends at min_idepth or
+  // max_idepth are minima. Both tie with kAccept end to end (docs/mapping.md, "Photometric
+  // stereo").
+  IntervalEndMinimum ssd_interval_end = IntervalEndMinimum::kAccept;
   // A 1-px keyframe step along the epipolar line must map to [1/s, s] px in the current frame
   // (strong scale change breaks the equidistant sampling).
   double max_epipolar_scale = 2.0;
@@ -233,6 +242,13 @@ struct MappingOptions {
             "Second-best SSD (> 2 px away) must exceed ratio * best (default 1.5).");
     v.Field("ssd_ambiguity_variance", &ssd_ambiguity_variance,
             "Add the weighted spread of the other SSD minima to the variance (default true).");
+    v.Choice("ssd_interval_end", &ssd_interval_end,
+             {{"accept", IntervalEndMinimum::kAccept},
+              {"skip", IntervalEndMinimum::kSkip},
+              {"outlier", IntervalEndMinimum::kOutlier}},
+             "SSD best at an end of the prior interval (not min_idepth / max_idepth): fuse it "
+             "(accept, Engel 2013; default), no observation (skip), or an outlier of the "
+             "hypothesis (outlier).");
     v.Field("max_epipolar_scale", &max_epipolar_scale,
             "Maximum scale change along the epipolar line (default 2).");
     v.Field("use_line_stereo", &use_line_stereo, "Line-guided stereo on matched edges.");

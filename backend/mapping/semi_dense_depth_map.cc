@@ -145,6 +145,18 @@ GaussianPosterior FuseGaussian(double prior, double prior_var, double prior_shar
 
 }  // namespace
 
+void SemiDenseDepthMap::CountOutlier(int i, const MappingOptions& options) {
+  if (options.outlier_model == MappingOptions::OutlierModel::kInlierRatio) {
+    outlier_evidence_[i] += 1.0f;
+    const double a = options.inlier_prior_count + inlier_evidence_[i];
+    const double b = options.inlier_prior_count + outlier_evidence_[i];
+    if (a / (a + b) < options.min_inlier_ratio) valid_[i] = 0;
+    return;
+  }
+  validity_[i] = static_cast<int16_t>(validity_[i] - options.validity_decrement);
+  if (validity_[i] <= 0) valid_[i] = 0;
+}
+
 bool SemiDenseDepthMap::Fuse(int i, double idepth_obs, double idepth_obs_var, double correlation,
                              const MappingOptions& options) {
   const double prior = idepth_[i], prior_var = idepth_var_[i];

@@ -122,6 +122,10 @@ class SemiDenseDepthMap {
   // Returns true when fused (kInlierRatio: when C1 > C2).
   bool Fuse(int i, double idepth_obs, double idepth_obs_var, double correlation,
             const MappingOptions& options);
+  // An observation that contradicts the hypothesis without a depth of its own (the SSD search's
+  // best at an end of the prior interval): counted as an outlier of options.outlier_model
+  // (validity_decrement; kInlierRatio: one more outlier count, C2 = 1), the depth unchanged.
+  void CountOutlier(int i, const MappingOptions& options);
   // A stereo observation: correlation = options.stereo_error_correlation.
   bool Fuse(int i, double idepth_obs, double idepth_obs_var, const MappingOptions& options) {
     return Fuse(i, idepth_obs, idepth_obs_var, options.stereo_error_correlation, options);
