@@ -196,8 +196,7 @@ bool SemiDenseDepthMap::Fuse(int i, double idepth_obs, double idepth_obs_var, do
   }
   const double gate = options.outlier_gate_sigmas;
   if (diff * diff > gate * gate * (prior_var + idepth_obs_var)) {
-    validity_[i] = static_cast<int16_t>(validity_[i] - options.validity_decrement);
-    if (validity_[i] <= 0) valid_[i] = 0;
+    CountOutlier(i, options);
     return false;
   }
   const GaussianPosterior fused =
