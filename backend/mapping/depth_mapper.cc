@@ -48,6 +48,7 @@ void FrameUpdateStats::AddCounts(const FrameUpdateStats& other) {
   ssd_attempts += other.ssd_attempts;
   ssd_ok += other.ssd_ok;
   ssd_interval_end += other.ssd_interval_end;
+  ssd_skipped += other.ssd_skipped;
   fused += other.fused;
   created += other.created;
   outliers += other.outliers;
@@ -174,6 +175,26 @@ bool DepthMapper::NarrowPrior(int index, const Eigen::Vector2d& pixel,
          (end_near - end_far).norm() < options_.line_stereo_min_interval_px;
 }
 
+bool DepthMapper::UninformativeSearch(int index, const Eigen::Vector2d& pixel,
+                                      const EpipolarGeometry& geometry, const EpipolarPatch& patch,
+                                      double idepth_min, double idepth_max) const {
+  const double ratio = options_.uninformative_search_ratio;
+  if (!(ratio > 0.0)) return false;
+  // |d pixel / d idepth| = const / q_z^2 with q_z linear in the inverse depth: with both ends in
+  // front of the current camera its largest value over the interval is at an end.
+  Eigen::Vector2d end_far, end_near;
+  if (!geometry.Project(pixel, idepth_min, &end_far) ||
+      !geometry.Project(pixel, idepth_max, &end_near)) {
+    return false;
+  }
+  const double jacobian_sq = std::max(geometry.IdepthJacobian(pixel, idepth_min).squaredNorm(),
+                                      geometry.IdepthJacobian(pixel, idepth_max).squaredNorm());
+  if (!std::isfinite(jacobian_sq) || !(jacobian_sq > 0.0)) return false;
+  const double sigma = options_.sigma_epipolar_px;
+  const double min_idepth_var = GeometricDisparityVar(patch, sigma * sigma) / jacobian_sq;
+  return min_idepth_var > ratio * map_.idepth_var(index);
+}
+
 void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
                               const EpipolarGeometry& geometry,
                               const std::vector<MatchedLine>& lines_in_cur,
@@ -240,6 +261,10 @@ void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
   }
   if (status != StereoStatus::kOk) {
     if (patch_status != StereoStatus::kOk || ssd_first) return;
+    if (valid && UninformativeSearch(index, pixel, geometry, patch, idepth_min, idepth_max)) {
+      ++stats->ssd_skipped;
+      return;
+    }
     ++stats->ssd_attempts;
     status = SearchEpipolarSsd(current, geometry, patch, pixel, idepth_min, idepth_max, options_,
                                &observation);

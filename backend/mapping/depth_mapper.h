@@ -60,6 +60,8 @@ struct FrameUpdateStats {
   int ssd_ok = 0;
   // SSD searches whose best lay at an open end of the prior interval (options.ssd_interval_end).
   int ssd_interval_end = 0;
+  // SSD searches of hypotheses skipped as uninformative (options.uninformative_search_ratio).
+  int ssd_skipped = 0;
   int fused = 0;                 // EKF updates
   int created = 0;               // new hypotheses from a full-range search
   int outliers = 0;              // observations rejected by the EKF gate
@@ -189,6 +191,12 @@ class DepthMapper {
   // less than options.line_stereo_min_interval_px on the epipolar line.
   bool NarrowPrior(int index, const Eigen::Vector2d& pixel, const EpipolarGeometry& geometry,
                    double idepth_min, double idepth_max) const;
+  // The SSD search of the valid hypothesis at index cannot shrink its variance by more than
+  // 1 / (1 + options.uninformative_search_ratio): its observation's geometric variance alone (at
+  // the largest disparity Jacobian over [idepth_min, idepth_max]) exceeds ratio x the variance.
+  bool UninformativeSearch(int index, const Eigen::Vector2d& pixel,
+                           const EpipolarGeometry& geometry, const EpipolarPatch& patch,
+                           double idepth_min, double idepth_max) const;
   // Stereo + fusion of one candidate pixel.
   void UpdatePixel(int index, const ImagePyramid& current, const EpipolarGeometry& geometry,
                    const std::vector<MatchedLine>& lines_in_cur, FrameUpdateStats* stats);

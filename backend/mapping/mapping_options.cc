@@ -1,5 +1,6 @@
 #include "backend/mapping/mapping_options.h"
 
+#include <cmath>
 #include <sstream>
 
 namespace pldvo {
@@ -32,6 +33,9 @@ std::string MappingOptions::Check() const {
   }
   if (max_ssd_rms <= 0.0) error << "max_ssd_rms must be > 0; ";
   if (ssd_uniqueness_ratio < 1.0) error << "ssd_uniqueness_ratio must be >= 1; ";
+  if (!(uninformative_search_ratio >= 0.0 && std::isfinite(uninformative_search_ratio))) {
+    error << "uninformative_search_ratio must be finite and >= 0; ";
+  }
   if (max_epipolar_scale < 1.0) error << "max_epipolar_scale must be >= 1; ";
   if (!(line_stereo_min_interval_px >= 0.0)) error << "line_stereo_min_interval_px must be >= 0; ";
   if (min_line_epipolar_angle_deg < 0.0 || min_line_epipolar_angle_deg >= 90.0) {

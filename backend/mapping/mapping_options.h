@@ -77,6 +77,12 @@ struct MappingOptions {
   // max_idepth are minima. Both tie with kAccept end to end (docs/mapping.md, "Photometric
   // stereo").
   IntervalEndMinimum ssd_interval_end = IntervalEndMinimum::kAccept;
+  // Skip a valid hypothesis' SSD search when even the observation's geometric variance (its
+  // lower bound: sigma_epipolar_px over the gradient's cos, at the interval's largest disparity
+  // Jacobian) exceeds this multiple of the hypothesis' variance: the fusion would shrink the
+  // variance by less than 1 / (1 + ratio). Saves the searches of short baselines (as LSD-SLAM
+  // skips short epipolar lines). 0: never skip (default; docs/mapping.md, "Photometric stereo").
+  double uninformative_search_ratio = 0.0;
   // A 1-px keyframe step along the epipolar line must map to [1/s, s] px in the current frame
   // (strong scale change breaks the equidistant sampling).
   double max_epipolar_scale = 2.0;
@@ -249,6 +255,9 @@ struct MappingOptions {
              "SSD best at an end of the prior interval (not min_idepth / max_idepth): fuse it "
              "(accept, Engel 2013; default), no observation (skip), or an outlier of the "
              "hypothesis (outlier).");
+    v.Field("uninformative_search_ratio", &uninformative_search_ratio,
+            "Skip a hypothesis' SSD search when the observation's geometric variance exceeds "
+            "ratio x its variance (0: never; default 0).");
     v.Field("max_epipolar_scale", &max_epipolar_scale,
             "Maximum scale change along the epipolar line (default 2).");
     v.Field("use_line_stereo", &use_line_stereo, "Line-guided stereo on matched edges.");
