@@ -17,6 +17,7 @@
 #include "core/image_pyramid.h"
 #include "core/pinhole_camera.h"
 #include "core/se3.h"
+#include "tests/backend/translated_plane.h"
 
 namespace pldvo {
 namespace {
@@ -35,20 +36,11 @@ cv::Mat StripeTexture() {
   return texture;
 }
 
-// The image of a camera at +baseline m along x: the keyframe's image shifted left by
-// fx * baseline / depth px.
 cv::Mat ImageAt(const cv::Mat& texture, double baseline) {
-  const double shift = kCamera.fx * baseline / kPlaneDepth;
-  const cv::Mat warp = (cv::Mat_<double>(2, 3) << 1, 0, kMargin + shift, 0, 1, kMargin);
-  cv::Mat image;
-  cv::warpAffine(texture, image, warp, cv::Size(kCamera.width, kCamera.height),
-                 cv::INTER_LINEAR | cv::WARP_INVERSE_MAP);
-  return image;
+  return test::TranslatedPlaneImage(texture, kCamera, kPlaneDepth, kMargin, baseline);
 }
 
-SE3 CurFromRef(double baseline) {
-  return SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(-baseline, 0.0, 0.0));
-}
+SE3 CurFromRef(double baseline) { return test::TranslatedCurFromRef(baseline); }
 
 // One edge pixel, baseline 0.1 m (13 px of disparity at the true inverse depth 1): an interval
 // that ends short of the truth has its best SSD at that end.

@@ -16,6 +16,7 @@
 #include "backend/mapping/semi_dense_depth_map.h"
 #include "core/pinhole_camera.h"
 #include "core/se3.h"
+#include "tests/backend/translated_plane.h"
 
 namespace pldvo {
 namespace {
@@ -34,15 +35,8 @@ cv::Mat RandomTexture() {
   return texture;
 }
 
-// The image of a camera at +baseline m along x: the keyframe's image shifted by
-// fx * baseline / depth px.
 cv::Mat ImageAt(const cv::Mat& texture, double baseline) {
-  const double shift = kCamera.fx * baseline / kPlaneDepth;
-  const cv::Mat warp = (cv::Mat_<double>(2, 3) << 1, 0, kMargin + shift, 0, 1, kMargin);
-  cv::Mat image;
-  cv::warpAffine(texture, image, warp, cv::Size(kCamera.width, kCamera.height),
-                 cv::INTER_LINEAR | cv::WARP_INVERSE_MAP);
-  return image;
+  return test::TranslatedPlaneImage(texture, kCamera, kPlaneDepth, kMargin, baseline);
 }
 
 DepthMapper MapperAtTruth(const cv::Mat& texture, double ratio) {
@@ -67,7 +61,7 @@ TEST(UninformativeSearchTest, SkippedSearchesWouldNotHaveShrunkTheVariance) {
     DepthMapper skipping = MapperAtTruth(texture, kRatio);
     const SemiDenseDepthMap before = searched.depth_map();
     const cv::Mat image = ImageAt(texture, baseline);
-    const SE3 cur_from_ref(Eigen::Matrix3d::Identity(), Eigen::Vector3d(-baseline, 0.0, 0.0));
+    const SE3 cur_from_ref = test::TranslatedCurFromRef(baseline);
     const FrameUpdateStats all = searched.UpdateWithFrame(image, cur_from_ref, {});
     const FrameUpdateStats some = skipping.UpdateWithFrame(image, cur_from_ref, {});
     EXPECT_EQ(all.ssd_skipped, 0);
