@@ -26,6 +26,7 @@
 #ifndef PLDVO_BACKEND_MAPPING_DEPTH_MAPPER_H_
 #define PLDVO_BACKEND_MAPPING_DEPTH_MAPPER_H_
 
+#include <cstdint>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -43,31 +44,33 @@
 
 namespace pldvo {
 
+// Counts are 64-bit: summed over a run (MappingWorker::stereo_counts) they pass 2^31 after
+// some 30 000 frames.
 struct FrameUpdateStats {
-  int line_attempts = 0;      // edge pixels with a matched line
-  int line_ok = 0;            // fused or created from the line-guided match
-  int line_refined = 0;       // of which: refined (or fused) by the restricted SSD search
-  int line_fallback = 0;      // near-parallel: fell back to the SSD search
-  int line_rejected = 0;      // out of the prior interval or failed the SSD check
-  int line_out_of_range = 0;  // of which: outside the prior interval idepth +- 2 sigma
+  int64_t line_attempts = 0;      // edge pixels with a matched line
+  int64_t line_ok = 0;            // fused or created from the line-guided match
+  int64_t line_refined = 0;       // of which: refined (or fused) by the restricted SSD search
+  int64_t line_fallback = 0;      // near-parallel: fell back to the SSD search
+  int64_t line_rejected = 0;      // out of the prior interval or failed the SSD check
+  int64_t line_out_of_range = 0;  // of which: outside the prior interval idepth +- 2 sigma
   // Edge pixels with a matched line searched by the SSD instead: their prior interval is
   // narrower than options.line_stereo_min_interval_px.
-  int line_narrow_prior = 0;
+  int64_t line_narrow_prior = 0;
   // Edge ids whose match was left out because most of the edge's hypotheses put the
   // intersection outside their prior interval (options.line_match_max_outside_fraction).
   std::vector<int> dropped_line_matches;
-  int ssd_attempts = 0;
-  int ssd_ok = 0;
+  int64_t ssd_attempts = 0;
+  int64_t ssd_ok = 0;
   // SSD searches whose best lay at an open end of the prior interval (options.ssd_interval_end).
-  int ssd_interval_end = 0;
+  int64_t ssd_interval_end = 0;
   // SSD searches of hypotheses skipped as uninformative (options.uninformative_search_ratio).
-  int ssd_skipped = 0;
-  int fused = 0;                 // EKF updates
-  int created = 0;               // new hypotheses from a full-range search
-  int outliers = 0;              // observations rejected by the EKF gate
-  int removed = 0;               // isolated hypotheses removed
-  int filled = 0;                // holes filled
-  int num_edge_pixels = 0;       // candidates on an edge that were processed
+  int64_t ssd_skipped = 0;
+  int64_t fused = 0;             // EKF updates
+  int64_t created = 0;           // new hypotheses from a full-range search
+  int64_t outliers = 0;          // observations rejected by the EKF gate
+  int64_t removed = 0;           // isolated hypotheses removed
+  int64_t filled = 0;            // holes filled
+  int64_t num_edge_pixels = 0;   // candidates on an edge that were processed
   double edge_stereo_ms = 0.0;   // wall time of the stereo on edge pixels
   double other_stereo_ms = 0.0;  // wall time of the stereo on all other pixels
 

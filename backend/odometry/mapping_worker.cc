@@ -145,6 +145,11 @@ int MappingWorker::line_depth_outliers() const {
   return line_depth_outliers_;
 }
 
+FrameUpdateStats MappingWorker::stereo_counts() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return stereo_counts_;
+}
+
 int MappingWorker::idepth_corrections_applied() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return idepth_corrections_applied_;
@@ -214,16 +219,22 @@ void MappingWorker::Run(const MappingJob& job) {
         keyframe_id_ = job.keyframe_id;
         num_updates_ = 0;
         break;
-      case MappingJob::Kind::kUpdate:
+      case MappingJob::Kind::kUpdate: {
         if (job.keyframe_id != keyframe_id_) {  // for a keyframe no longer current
           state_map_ = std::move(state_map);
           return;
         }
-        mapper_.UpdateWithFrame(InReferenceBrightness(job.image, job.brightness), job.cur_from_kf,
-                                job.lines_in_cur, job.pose_covariance, job.line_cov_scale);
+        const FrameUpdateStats counts = mapper_.UpdateWithFrame(
+            InReferenceBrightness(job.image, job.brightness), job.cur_from_kf, job.lines_in_cur,
+            job.pose_covariance, job.line_cov_scale);
         ++num_updates_;
         if (updates_since_random_init_ >= 0) ++updates_since_random_init_;
+        std::lock_guard<std::mutex> lock(mutex_);
+        stereo_counts_.AddCounts(counts);
+        stereo_counts_.removed += counts.removed;
+        stereo_counts_.filled += counts.filled;
         break;
+      }
       case MappingJob::Kind::kLineDepths:
       case MappingJob::Kind::kIdepthCorrections: {
         if (job.keyframe_id != keyframe_id_) {  // for a keyframe no longer current

@@ -133,6 +133,9 @@ class MappingWorker {
   int line_depth_outliers() const;
   // Sum of DepthMapper::ApplyIdepthCorrections over every kIdepthCorrections job.
   int idepth_corrections_applied() const;
+  // The stereo's counts (FrameUpdateStats: searches, line-guided matches, fusions, outliers,
+  // removed and filled hypotheses) summed over every kUpdate job.
+  FrameUpdateStats stereo_counts() const;
 
  private:
   void Run(const MappingJob& job);
@@ -188,6 +191,7 @@ class MappingWorker {
   int line_depths_fused_ = 0;
   int line_depth_outliers_ = 0;
   int idepth_corrections_applied_ = 0;
+  FrameUpdateStats stereo_counts_;
   int failed_keyframe_id_ = -1;
   std::thread thread_;
 };

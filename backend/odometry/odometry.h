@@ -124,6 +124,8 @@ class Odometry {
   OdometryStatistics statistics() const;
   // Wall time of every mapping job (ms), for the summary.
   std::vector<double> MappingJobTimesMs() const { return mapper_->JobTimesMs(); }
+  // The mapping's stereo counts summed over the run (MappingWorker::stereo_counts).
+  FrameUpdateStats StereoCounts() const { return mapper_->stereo_counts(); }
   // Wall time of every solved edge BA window (problem build + solve on the solving thread, ms).
   const std::vector<double>& EdgeBAWindowTimesMs() const { return edge_ba_times_ms_; }
   // Wall time of the line covariances of every window that computed them (ms).

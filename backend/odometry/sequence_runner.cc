@@ -600,6 +600,24 @@ SequenceRunResult SequenceRunner::Run() {
   summary["alternatives_gated"] = stats.alternatives_gated;
   summary["dropped_mapping_updates"] = stats.dropped_mapping_updates;
   summary["failed_mapping_jobs"] = stats.failed_mapping_jobs;
+  // The stereo of every mapping update, summed over the run (FrameUpdateStats,
+  // docs/mapping.md): searches, line-guided matches, fusions, outliers, removed and filled.
+  const FrameUpdateStats stereo = odometry.StereoCounts();
+  summary["stereo"] = {{"ssd_attempts", stereo.ssd_attempts},
+                       {"ssd_ok", stereo.ssd_ok},
+                       {"ssd_interval_end", stereo.ssd_interval_end},
+                       {"ssd_skipped", stereo.ssd_skipped},
+                       {"line_attempts", stereo.line_attempts},
+                       {"line_ok", stereo.line_ok},
+                       {"line_refined", stereo.line_refined},
+                       {"line_fallback", stereo.line_fallback},
+                       {"line_rejected", stereo.line_rejected},
+                       {"line_narrow_prior", stereo.line_narrow_prior},
+                       {"fused", stereo.fused},
+                       {"created", stereo.created},
+                       {"outliers", stereo.outliers},
+                       {"removed", stereo.removed},
+                       {"filled", stereo.filled}};
   summary["parallel_mapping"] = config_.odometry.parallel_mapping;
   summary["frontend_thread"] = config_.odometry.frontend_thread;
   summary["seconds"] = run_seconds;

@@ -78,13 +78,17 @@ TEST(UninformativeSearchTest, SkippedSearchesWouldNotHaveShrunkTheVariance) {
       largest_shrink = std::max(largest_shrink, 1.0 - full / before.idepth_var(i));
     }
     std::printf(
-        "baseline %.3f m: %d searches, %d skipped, %d variances differ, largest shrink "
+        "baseline %.3f m: %lld searches, %lld skipped, %d variances differ, largest shrink "
         "%.4f (bound %.4f)\n",
-        baseline, all.ssd_attempts, some.ssd_skipped, changed, largest_shrink,
-        1.0 / (1.0 + kRatio));
+        baseline, static_cast<long long>(all.ssd_attempts),
+        static_cast<long long>(some.ssd_skipped), changed, largest_shrink, 1.0 / (1.0 + kRatio));
     EXPECT_LE(largest_shrink, 1.0 / (1.0 + kRatio) + 1e-6);
-    if (baseline < 0.005) EXPECT_GT(some.ssd_skipped, all.ssd_attempts / 2);
-    if (baseline > 0.04) EXPECT_EQ(some.ssd_skipped, 0);
+    if (baseline < 0.005) {
+      EXPECT_GT(some.ssd_skipped, all.ssd_attempts / 2);
+    }
+    if (baseline > 0.04) {
+      EXPECT_EQ(some.ssd_skipped, 0);
+    }
   }
 }
 
