@@ -600,8 +600,8 @@ SequenceRunResult SequenceRunner::Run() {
   summary["alternatives_gated"] = stats.alternatives_gated;
   summary["dropped_mapping_updates"] = stats.dropped_mapping_updates;
   summary["failed_mapping_jobs"] = stats.failed_mapping_jobs;
-  // The stereo of every mapping update, summed over the run (FrameUpdateStats,
-  // docs/mapping.md): searches, line-guided matches, fusions, outliers, removed and filled.
+  // The stereo of every mapping update, summed over the run (FrameUpdateStats; the keys in
+  // docs/odometry.md): searches, line-guided matches, fusions, outliers, removed and filled.
   const FrameUpdateStats stereo = odometry.StereoCounts();
   summary["stereo"] = {{"ssd_attempts", stereo.ssd_attempts},
                        {"ssd_ok", stereo.ssd_ok},
