@@ -196,7 +196,7 @@ EvaluationResult EvaluateTrajectory(const Trajectory& ground_truth, const Trajec
   // interval t_j - t_i (per second).
   std::vector<int> gt_of_estimate(estimate.size(), -1);
   for (const auto& [i, k] : matches) gt_of_estimate[i] = k;
-  double trans_squared = 0.0, rot_squared = 0.0;
+  double trans_squared = 0.0, rot_squared = 0.0, still_squared = 0.0;
   for (const auto& [i, k] : matches) {
     const int j = NearestPose(estimate, estimate[i].timestamp + options.rpe_delta);
     if (j <= i || gt_of_estimate[j] < 0) continue;
@@ -212,15 +212,20 @@ EvaluationResult EvaluateTrajectory(const Trajectory& ground_truth, const Trajec
     const double trans_per_s = error.translation().norm() / interval;
     const double rot_per_s = RotationAngle(error.rotation()) / interval;
     trans_squared += trans_per_s * trans_per_s;
+    // A still estimate (R, 0): the error's translation is -R_gt^T t_gt, of length |t_gt|.
+    const double still_per_s = gt_j_from_i.translation().norm() / interval;
+    still_squared += still_per_s * still_per_s;
     rot_squared += rot_per_s * rot_per_s;
     ++result.num_pairs;
   }
   if (result.num_pairs > 0) {
     result.rpe_cm_s = 100.0 * std::sqrt(trans_squared / result.num_pairs);
     result.rpe_deg_s = 180.0 / M_PI * std::sqrt(rot_squared / result.num_pairs);
+    result.rpe_cm_s_still = 100.0 * std::sqrt(still_squared / result.num_pairs);
   } else {
     result.rpe_cm_s = std::numeric_limits<double>::quiet_NaN();
     result.rpe_deg_s = std::numeric_limits<double>::quiet_NaN();
+    result.rpe_cm_s_still = std::numeric_limits<double>::quiet_NaN();
   }
 
   // Scale per window: path lengths over the steps between consecutive associated poses.

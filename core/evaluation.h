@@ -79,6 +79,10 @@ struct EvaluationResult {
   // (deg/s). NaN when no pair exists (estimate shorter than rpe_delta).
   double rpe_cm_s = 0.0;
   double rpe_deg_s = 0.0;
+  // rpe_cm_s of an estimate that never moves, over the same pairs: the RMS of the ground truth's
+  // own translation per second (cm/s; NaN without pairs). A translational RPE near it says the
+  // translation was not tracked.
+  double rpe_cm_s_still = 0.0;
   // The alignment's scale: ground-truth metres per estimate unit.
   double scale = 1.0;
   // Fraction of the ground-truth time span covered by associated estimate poses, in [0, 1]:

@@ -2,9 +2,9 @@
 # One command, one table (issue #41, docs/benchmark.md): renders the development set (every
 # synthetic family at a few seeds) unless present, adds the real sequences when present, runs
 # sdvo and points_lines on all of them from several random initial maps through `pldvo ablate`,
-# and prints per sequence: RPE cm/s, rotation RPE deg/s, lost events and scale segments, each the
-# median [min, max] over the initial maps, with the points_lines / sdvo ratio of the medians;
-# then one line per target.
+# and prints per sequence: RPE cm/s, the RPE of an estimate that never moves, rotation RPE deg/s,
+# lost events, scale segments and the motion direction error, each the median [min, max] over
+# the initial maps, with the points_lines / sdvo ratio of the medians; then one line per target.
 #
 # Usage: scripts/benchmark.sh OUT
 # Environment:
@@ -97,13 +97,19 @@ awk -F, -v wanted="$wanted" -v repeats="$repeats" -v frames="$frames" '
     v[d SUBSEP c SUBSEP "lost", k] = $col["lost_events"]
     v[d SUBSEP c SUBSEP "seg", k] = $col["scale_segments"]
     v[d SUBSEP c SUBSEP "dir", k] = $col["motion_direction_error_deg_median"]
+    if ("rpe_cm_s_still" in col) v[d SUBSEP c SUBSEP "still", k] = $col["rpe_cm_s_still"]
   }
   END {
-    split("rpe deg lost seg dir", metrics, " ")
-    label["rpe"] = "RPE cm/s"; label["deg"] = "RPE deg/s"
+    # "still": the RPE of an estimate that never moves (the motion of the ground truth per
+    # second, docs/evaluation.md); absent from results.csv files written before it existed.
+    names = "rpe deg lost seg dir"
+    if ("rpe_cm_s_still" in col) names = "rpe still deg lost seg dir"
+    num_metrics = split(names, metrics, " ")
+    label["rpe"] = "RPE cm/s"; label["still"] = "still cm/s"; label["deg"] = "RPE deg/s"
     label["lost"] = "lost events"; label["seg"] = "scale segments"
     label["dir"] = "motion dir deg"
-    fmt["rpe"] = "%.2f"; fmt["deg"] = "%.3f"; fmt["lost"] = "%g"; fmt["seg"] = "%g"
+    fmt["rpe"] = "%.2f"; fmt["still"] = "%.2f"; fmt["deg"] = "%.3f"; fmt["lost"] = "%g"
+    fmt["seg"] = "%g"
     fmt["dir"] = "%.1f"
     for (i = 1; i <= nd; ++i) {
       d = order[i]
@@ -111,7 +117,7 @@ awk -F, -v wanted="$wanted" -v repeats="$repeats" -v frames="$frames" '
              "%d / %d points_lines)\n", d, frames, repeats, ok[d, "sdvo"], runs[d, "sdvo"],
              ok[d, "points_lines"], runs[d, "points_lines"]
       printf "  %-15s %-26s %-26s %s\n", "", "sdvo", "points_lines", "pl/sdvo"
-      for (m = 1; m <= 5; ++m) {
+      for (m = 1; m <= num_metrics; ++m) {
         key = metrics[m]
         a = cell(d SUBSEP "sdvo" SUBSEP key, ok[d, "sdvo"], fmt[key])
         b = cell(d SUBSEP "points_lines" SUBSEP key, ok[d, "points_lines"], fmt[key])

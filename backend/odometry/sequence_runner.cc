@@ -393,6 +393,7 @@ std::string AddEvaluation(const Trajectory& ground_truth, const Trajectory& esti
     *gt_from_est = eval.gt_from_est;
     s["rpe_cm_s"] = NumberOrNull(eval.rpe_cm_s);
     s["rpe_deg_s"] = NumberOrNull(eval.rpe_deg_s);
+    s["rpe_cm_s_still"] = NumberOrNull(eval.rpe_cm_s_still);
     s["ate_m"] = eval.ate_m;
     s["coverage"] = eval.coverage;
     s["scale"] = eval.scale;
@@ -401,9 +402,9 @@ std::string AddEvaluation(const Trajectory& ground_truth, const Trajectory& esti
     s["ground_truth_constant_velocity_start"] = eval.constant_velocity_start_poses;
     s["skipped_ground_truth_poses"] = eval.skipped_ground_truth_poses;
     std::ostringstream line;
-    line << std::fixed << std::setprecision(3) << "RPE " << eval.rpe_cm_s << " cm/s, "
-         << eval.rpe_deg_s << " deg/s; ATE " << std::setprecision(4) << eval.ate_m
-         << " m; coverage " << std::setprecision(3) << eval.coverage;
+    line << std::fixed << std::setprecision(3) << "RPE " << eval.rpe_cm_s << " cm/s (still "
+         << eval.rpe_cm_s_still << "), " << eval.rpe_deg_s << " deg/s; ATE " << std::setprecision(4)
+         << eval.ate_m << " m; coverage " << std::setprecision(3) << eval.coverage;
     if (eval.skipped_ground_truth_poses > 0) {
       line << "; from ground-truth pose " << eval.skipped_ground_truth_poses
            << " on (the poses before move at one constant velocity)";
@@ -416,6 +417,7 @@ std::string AddEvaluation(const Trajectory& ground_truth, const Trajectory& esti
   } catch (const std::exception& e) {
     s["rpe_cm_s"] = nullptr;
     s["rpe_deg_s"] = nullptr;
+    s["rpe_cm_s_still"] = nullptr;
     s["ate_m"] = nullptr;
     s["coverage"] = 0.0;
     s["evaluation_error"] = e.what();

@@ -58,6 +58,7 @@ int RunEval(const CommandContext& context) {
       json["ate_m"] = result.ate_m;
       json["rpe_cm_s"] = NumberOrNull(result.rpe_cm_s);
       json["rpe_deg_s"] = NumberOrNull(result.rpe_deg_s);
+      json["rpe_cm_s_still"] = NumberOrNull(result.rpe_cm_s_still);
       json["scale"] = result.scale;
       json["coverage"] = result.coverage;
       json["scale_drift"] = NumberOrNull(result.scale_drift);
@@ -76,6 +77,8 @@ int RunEval(const CommandContext& context) {
               << " m\n"
               << "RPE translation:           " << std::setprecision(3) << result.rpe_cm_s
               << " cm/s  (delta " << options.rpe_delta << " s, " << result.num_pairs << " pairs)\n"
+              << "RPE translation, still:    " << result.rpe_cm_s_still
+              << " cm/s  (an estimate that never moves)\n"
               << "RPE rotation:              " << result.rpe_deg_s << " deg/s\n"
               << "rotation ratio (est / gt): " << rotation_ratio << "\n"
               << "scale (gt per est unit):   " << std::setprecision(6) << result.scale << "\n"

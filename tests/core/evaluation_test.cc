@@ -240,6 +240,31 @@ TEST(EvaluateTrajectory, RpeOfConstantRotationalDrift) {
   EXPECT_NEAR(result.ate_m, 0.0, kTolerance);
 }
 
+TEST(EvaluateTrajectory, StillRpeIsTheGroundTruthsOwnMotionWhichAStillEstimateScores) {
+  // gt: 1 m/s along x for 10 s at 10 Hz, the camera turning about z at 0.2 rad/s. Every 1 s pair
+  // moves 1 m whatever the turn: the still figure is 100 cm/s, for an exact estimate (RPE 0) as
+  // for one that only turns (RPE 100 cm/s, rotation exact). The turning-only estimate stands at
+  // the origin up to 1e-9 m (no alignment can place identical points) and is aligned without
+  // scale.
+  Trajectory gt, turning_only;
+  for (int i = 0; i <= 100; ++i) {
+    const double t = 0.1 * i;
+    const Eigen::Quaterniond turn(Eigen::AngleAxisd(0.2 * t, Eigen::Vector3d::UnitZ()));
+    gt.push_back(Pose(t, Eigen::Vector3d(t, 0, 0), turn));
+    turning_only.push_back(Pose(t, 1e-9 * Eigen::Vector3d(i % 2, i % 3, i % 5), turn));
+  }
+  const EvaluationResult exact = EvaluateTrajectory(gt, gt);
+  EXPECT_NEAR(exact.rpe_cm_s, 0.0, 1e-7);
+  EXPECT_NEAR(exact.rpe_cm_s_still, 100.0, 1e-7);
+  EvaluationOptions no_scale;
+  no_scale.align_scale = false;
+  const EvaluationResult still = EvaluateTrajectory(gt, turning_only, no_scale);
+  EXPECT_EQ(still.num_pairs, 91);
+  EXPECT_NEAR(still.rpe_cm_s, 100.0, 1e-5);
+  EXPECT_NEAR(still.rpe_cm_s_still, 100.0, 1e-7);
+  EXPECT_NEAR(still.rpe_deg_s, 0.0, 1e-7);
+}
+
 TEST(EvaluateTrajectory, CoverageCountsDroppedFrames) {
   // 100 gt poses at 10 Hz; the estimate loses 20 frames in the middle (tracking failure): 80
   // associated poses of 0.1 s over a 9.9 + 0.1 s span, coverage 0.8. The remaining poses are
@@ -284,6 +309,7 @@ TEST(EvaluateTrajectory, ShortEstimateHasNoRpePairs) {
   const EvaluationResult result = EvaluateTrajectory(gt, gt);
   EXPECT_EQ(result.num_pairs, 0);
   EXPECT_TRUE(std::isnan(result.rpe_cm_s));
+  EXPECT_TRUE(std::isnan(result.rpe_cm_s_still));
 }
 
 TEST(EvaluateFrameMotion, AYawOfOneFrameShowsInTheTwoMotionsAroundIt) {

@@ -539,11 +539,13 @@ TEST(AblateCommandTest, TinyGridWritesTablesAndPlot) {
                       0),
             0u)
       << csv;
-  // The scale segments, the motion direction error, the rotation ratio and the windowed BA's
-  // re-anchored figures close the header (appended: scripts read the columns by position), and
+  // The scale segments, the motion direction error, the rotation ratio, the windowed BA's
+  // re-anchored figures and the still estimate's RPE close the header (appended: scripts read the
+  // columns by position), and
   // neither run of this short sequence re-initialises.
   EXPECT_NE(csv.find(",dir,scale_segments,motion_direction_error_deg_median,motion_rotation_ratio,"
-                     "reanchored_rpe_cm_s,reanchored_rpe_deg_s,keyframes_ate_m_ba\n"),
+                     "reanchored_rpe_cm_s,reanchored_rpe_deg_s,keyframes_ate_m_ba,"
+                     "rpe_cm_s_still\n"),
             std::string::npos)
       << csv;
   EXPECT_NE(csv.find("/lowtex__sdvo,1,"), std::string::npos) << csv;
@@ -551,6 +553,8 @@ TEST(AblateCommandTest, TinyGridWritesTablesAndPlot) {
   const std::string md = Slurp(out / "results.md");
   EXPECT_NE(md.find("| sequence | sdvo | points_lines |"), std::string::npos) << md;
   EXPECT_NE(md.find("| lowtex |"), std::string::npos) << md;
+  EXPECT_NE(md.find("### RPE translation of an estimate that never moves"), std::string::npos)
+      << md;
   EXPECT_NE(md.find("### Scale drift"), std::string::npos) << md;
   EXPECT_NE(md.find("### Scale segments"), std::string::npos) << md;
   EXPECT_NE(md.find("### Translation direction error"), std::string::npos) << md;
@@ -656,16 +660,19 @@ TEST(AblateCommandTest, ShardsThenCollectGiveTheResultsOfOneRun) {
   ASSERT_EQ(actual.size(), expected.size());
   // Columns: ..., 12 ms_median_tracking_thread, 13 ms_median_total, 14 init_seed, 15 dir,
   // 16 scale_segments, 17 motion_direction_error_deg_median, 18 motion_rotation_ratio,
-  // 19-21 re-anchored RPE, rotation RPE, keyframe ATE: all but the times and the run folder must
-  // agree.
+  // 19-21 re-anchored RPE, rotation RPE, keyframe ATE, 22 rpe_cm_s_still: all but the times and
+  // the run folder must agree.
   for (size_t row = 0; row < expected.size(); ++row) {
-    ASSERT_EQ(actual[row].size(), 22u);
-    ASSERT_EQ(expected[row].size(), 22u);
+    ASSERT_EQ(actual[row].size(), 23u);
+    ASSERT_EQ(expected[row].size(), 23u);
     EXPECT_EQ(expected[row][2], "ok") << "row " << row;
     // Without the windowed BA the re-anchored RPE is trajectory.txt's, the keyframe ATE empty.
     EXPECT_EQ(expected[row][19], expected[row][7]) << "row " << row;
     EXPECT_EQ(expected[row][21], "") << "row " << row;
-    for (size_t column = 0; column < 22; ++column) {
+    // The still estimate's RPE, the ground truth's own motion per second: these short renders
+    // are tracked, so each run's RPE is below it.
+    EXPECT_LT(std::stod(expected[row][7]), std::stod(expected[row][22])) << "row " << row;
+    for (size_t column = 0; column < 23; ++column) {
       if (column == 12 || column == 13 || column == 15) continue;
       EXPECT_EQ(actual[row][column], expected[row][column])
           << "row " << row << " column " << column;
