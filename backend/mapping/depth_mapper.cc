@@ -51,6 +51,7 @@ void FrameUpdateStats::AddCounts(const FrameUpdateStats& other) {
   ssd_skipped += other.ssd_skipped;
   fused += other.fused;
   created += other.created;
+  not_created += other.not_created;
   outliers += other.outliers;
   num_edge_pixels += other.num_edge_pixels;
 }
@@ -197,7 +198,7 @@ bool DepthMapper::UninformativeSearch(int index, const Eigen::Vector2d& pixel,
 
 void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
                               const EpipolarGeometry& geometry,
-                              const std::vector<MatchedLine>& lines_in_cur,
+                              const std::vector<MatchedLine>& lines_in_cur, double max_new_sigma,
                               FrameUpdateStats* stats) {
   const Eigen::Vector2d pixel(index % map_.width(), index / map_.width());
   const bool valid = map_.valid(index);
@@ -294,6 +295,10 @@ void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
       ++stats->outliers;
     }
   } else {
+    if (max_new_sigma > 0.0 && observation.idepth_var > max_new_sigma * max_new_sigma) {
+      ++stats->not_created;
+      return;
+    }
     map_.Set(index, observation.idepth, observation.idepth_var, options_.validity_initial,
              std::sqrt(correlation * observation.idepth_var));
     map_.CountObservation(index);
@@ -335,6 +340,8 @@ FrameUpdateStats DepthMapper::UpdateWithFrame(const cv::Mat& image, const SE3& c
     }
     lines = &kept;
   }
+  // The largest standard deviation of a new hypothesis, relative to the map's scale (0: none).
+  const double max_new_sigma = options_.new_hypothesis_max_relative_sigma * MeanInverseDepth(map_);
   // Two passes (edge pixels, then the rest) so that each is timed on its own, each in stripes of
   // pixels (pixel_stripes.h).
   const int stripes = NumStripes(options_);
@@ -348,7 +355,7 @@ FrameUpdateStats DepthMapper::UpdateWithFrame(const cv::Mat& image, const SE3& c
         if (!map_.candidate(i) || (map_.edge_id(i) >= 0) != (pass == 0)) continue;
         if (map_.blacklist(i) >= options_.blacklist_threshold) continue;
         if (pass == 0) ++counts->num_edge_pixels;
-        UpdatePixel(i, current, geometry, *lines, counts);
+        UpdatePixel(i, current, geometry, *lines, max_new_sigma, counts);
       }
     });
     for (const FrameUpdateStats& counts : stripe_stats) stats.AddCounts(counts);

@@ -67,6 +67,7 @@ struct FrameUpdateStats {
   int64_t ssd_skipped = 0;
   int64_t fused = 0;             // EKF updates
   int64_t created = 0;           // new hypotheses from a full-range search
+  int64_t not_created = 0;       // too uncertain (options.new_hypothesis_max_relative_sigma)
   int64_t outliers = 0;          // observations rejected by the EKF gate
   int64_t removed = 0;           // isolated hypotheses removed
   int64_t filled = 0;            // holes filled
@@ -74,7 +75,7 @@ struct FrameUpdateStats {
   double edge_stereo_ms = 0.0;   // wall time of the stereo on edge pixels
   double other_stereo_ms = 0.0;  // wall time of the stereo on all other pixels
 
-  // Adds the per-pixel counters of `other` (line_* to created, num_edge_pixels).
+  // Adds the per-pixel counters of `other` (line_* to not_created, num_edge_pixels).
   void AddCounts(const FrameUpdateStats& other);
 };
 
@@ -200,9 +201,11 @@ class DepthMapper {
   bool UninformativeSearch(int index, const Eigen::Vector2d& pixel,
                            const EpipolarGeometry& geometry, const EpipolarPatch& patch,
                            double idepth_min, double idepth_max) const;
-  // Stereo + fusion of one candidate pixel.
+  // Stereo + fusion of one candidate pixel; a new hypothesis needs an observation standard
+  // deviation of at most max_new_sigma (0: no limit).
   void UpdatePixel(int index, const ImagePyramid& current, const EpipolarGeometry& geometry,
-                   const std::vector<MatchedLine>& lines_in_cur, FrameUpdateStats* stats);
+                   const std::vector<MatchedLine>& lines_in_cur, double max_new_sigma,
+                   FrameUpdateStats* stats);
 
   PinholeCamera camera_;
   MappingOptions options_;

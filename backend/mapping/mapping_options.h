@@ -83,6 +83,11 @@ struct MappingOptions {
   // variance by less than 1 / (1 + ratio). Saves the searches of short baselines (as LSD-SLAM
   // skips short epipolar lines). 0: never skip (default; docs/mapping.md, "Photometric stereo").
   double uninformative_search_ratio = 0.0;
+  // A pixel without a hypothesis gets one only when the observation's standard deviation is at
+  // most this times the map's mean inverse depth (scale-free; LSD-SLAM creates below a fixed
+  // variance of its normalised map). At millimetre baselines a search lands anywhere in the
+  // range, and such hypotheses shrink the map keyframe by keyframe. 0: always create.
+  double new_hypothesis_max_relative_sigma = 0.0;
   // A 1-px keyframe step along the epipolar line must map to [1/s, s] px in the current frame
   // (strong scale change breaks the equidistant sampling).
   double max_epipolar_scale = 2.0;
@@ -258,6 +263,9 @@ struct MappingOptions {
     v.Field("uninformative_search_ratio", &uninformative_search_ratio,
             "Skip a hypothesis' SSD search when the observation's geometric variance exceeds "
             "ratio x its variance (0: never; default 0).");
+    v.Field("new_hypothesis_max_relative_sigma", &new_hypothesis_max_relative_sigma,
+            "Create a hypothesis only when the observation's standard deviation is at most this "
+            "times the map's mean inverse depth (0: always; default 0).");
     v.Field("max_epipolar_scale", &max_epipolar_scale,
             "Maximum scale change along the epipolar line (default 2).");
     v.Field("use_line_stereo", &use_line_stereo, "Line-guided stereo on matched edges.");

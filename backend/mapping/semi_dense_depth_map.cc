@@ -218,4 +218,15 @@ int SemiDenseDepthMap::CountValid() const {
   return static_cast<int>(std::count(valid_.begin(), valid_.end(), 1));
 }
 
+double MeanInverseDepth(const SemiDenseDepthMap& map) {
+  double sum = 0.0;
+  int count = 0;
+  for (int i = 0; i < map.num_pixels(); ++i) {
+    if (!map.valid(i)) continue;
+    sum += map.idepth(i);
+    ++count;
+  }
+  return count > 0 ? sum / count : 0.0;
+}
+
 }  // namespace pldvo

@@ -150,6 +150,9 @@ class SemiDenseDepthMap {
   std::vector<float> outlier_evidence_;
 };
 
+// Mean inverse depth of the valid hypotheses (0 when there are none).
+double MeanInverseDepth(const SemiDenseDepthMap& map);
+
 }  // namespace pldvo
 
 #endif  // PLDVO_BACKEND_MAPPING_SEMI_DENSE_DEPTH_MAP_H_

@@ -230,17 +230,6 @@ int RemoveLineOutliers(const SE3& cur_from_ref, double max_median_px, TrackingRe
   return removed;
 }
 
-double MeanInverseDepth(const SemiDenseDepthMap& map) {
-  double sum = 0.0;
-  int count = 0;
-  for (int i = 0; i < map.num_pixels(); ++i) {
-    if (!map.valid(i)) continue;
-    sum += map.idepth(i);
-    ++count;
-  }
-  return count > 0 ? sum / count : 0.0;
-}
-
 double ReferenceOverlap(const TrackingReference& reference, int level, const SE3& cur_from_ref) {
   if (level < 0 || level >= reference.num_levels()) return 1.0;
   const TrackingReferenceLevel& ref = reference.levels[level];

@@ -58,9 +58,6 @@ void SetMatchedLines(const std::vector<MatchedLine>& lines_at_level0, TrackingRe
 int RemoveLineOutliers(const SE3& cur_from_ref, double max_median_px, TrackingReference* reference,
                        std::vector<MatchedLine>* lines_at_level0);
 
-// Mean inverse depth of the valid hypotheses (0 when there are none).
-double MeanInverseDepth(const SemiDenseDepthMap& map);
-
 // Fraction of the reference points of `level` that reproject inside the current image with
 // cur_from_ref (1 when the level has no points).
 double ReferenceOverlap(const TrackingReference& reference, int level, const SE3& cur_from_ref);

@@ -617,6 +617,7 @@ SequenceRunResult SequenceRunner::Run() {
                        {"line_narrow_prior", stereo.line_narrow_prior},
                        {"fused", stereo.fused},
                        {"created", stereo.created},
+                       {"not_created", stereo.not_created},
                        {"outliers", stereo.outliers},
                        {"removed", stereo.removed},
                        {"filled", stereo.filled}};

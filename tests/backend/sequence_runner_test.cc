@@ -73,12 +73,13 @@ TEST(SequenceRunnerTest, WritesEveryOutputAndAGroundTruthEvoCanCompare) {
   EXPECT_NEAR(from_files.rpe_cm_s, result.summary["rpe_cm_s"].get<double>(), 1e-9);
   EXPECT_NEAR(from_files.ate_m, result.summary["ate_m"].get<double>(), 1e-12);
   // The stereo's counts: every successful observation (SSD or line-guided) is fused, rejected by
-  // the gate or creates a hypothesis; nothing is skipped by default.
+  // the gate, creates a hypothesis or is too uncertain to create one; no search is skipped by
+  // default.
   const nlohmann::json& stereo = result.summary["stereo"];
   EXPECT_GT(stereo["ssd_attempts"].get<int64_t>(), 10000);
   EXPECT_GT(stereo["line_ok"].get<int64_t>(), 1000);
   EXPECT_EQ(stereo["fused"].get<int64_t>() + stereo["outliers"].get<int64_t>() +
-                stereo["created"].get<int64_t>(),
+                stereo["created"].get<int64_t>() + stereo["not_created"].get<int64_t>(),
             stereo["ssd_ok"].get<int64_t>() + stereo["line_ok"].get<int64_t>());
   EXPECT_EQ(stereo["ssd_skipped"].get<int64_t>(), 0);
   // The plot has the ground truth and the aligned estimate.

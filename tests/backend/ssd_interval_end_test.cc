@@ -22,9 +22,9 @@
 namespace pldvo {
 namespace {
 
-const PinholeCamera kCamera{160, 120, 130.0, 130.0, 79.5, 59.5};
-constexpr double kPlaneDepth = 1.0;
-constexpr int kMargin = 40;
+const PinholeCamera& kCamera = test::kPlaneCamera;
+using test::kPlaneDepth;
+constexpr int kMargin = test::kPlaneMargin;
 
 // The stripes, wider than the image by kMargin on each side (CV_32F).
 cv::Mat StripeTexture() {

@@ -21,19 +21,10 @@
 namespace pldvo {
 namespace {
 
-const PinholeCamera kCamera{160, 120, 130.0, 130.0, 79.5, 59.5};
-constexpr double kPlaneDepth = 1.0;
-constexpr int kMargin = 40;
+const PinholeCamera& kCamera = test::kPlaneCamera;
+using test::kPlaneDepth;
+constexpr int kMargin = test::kPlaneMargin;
 constexpr double kPriorSigma = 0.1;  // 1/m: 0.65 px of disparity at 5 cm
-
-// Uniform noise blurred with sigma 2 px, wider than the image by kMargin on each side (CV_32F).
-cv::Mat RandomTexture() {
-  cv::Mat texture(kCamera.height + 2 * kMargin, kCamera.width + 2 * kMargin, CV_32F);
-  cv::RNG rng(7);
-  rng.fill(texture, cv::RNG::UNIFORM, 0.0, 255.0);
-  cv::GaussianBlur(texture, texture, cv::Size(0, 0), 2.0);
-  return texture;
-}
 
 cv::Mat ImageAt(const cv::Mat& texture, double baseline) {
   return test::TranslatedPlaneImage(texture, kCamera, kPlaneDepth, kMargin, baseline);
@@ -55,7 +46,7 @@ DepthMapper MapperAtTruth(const cv::Mat& texture, double ratio) {
 // most searches are skipped, at a long one none.
 TEST(UninformativeSearchTest, SkippedSearchesWouldNotHaveShrunkTheVariance) {
   constexpr double kRatio = 10.0;
-  const cv::Mat texture = RandomTexture();
+  const cv::Mat texture = test::BlurredNoiseTexture(7);
   for (const double baseline : {0.002, 0.01, 0.02, 0.05}) {
     DepthMapper searched = MapperAtTruth(texture, 0.0);
     DepthMapper skipping = MapperAtTruth(texture, kRatio);
