@@ -86,7 +86,8 @@ struct MappingOptions {
   // A pixel without a hypothesis gets one only when the observation's standard deviation is at
   // most this times the map's mean inverse depth (scale-free; LSD-SLAM creates below a fixed
   // variance of its normalised map). At millimetre baselines a search lands anywhere in the
-  // range, and such hypotheses shrink the map keyframe by keyframe. 0: always create.
+  // range, and such hypotheses shrink the map keyframe by keyframe. 0: always create (so does a
+  // map without hypotheses, which has no scale yet).
   double new_hypothesis_max_relative_sigma = 0.0;
   // A 1-px keyframe step along the epipolar line must map to [1/s, s] px in the current frame
   // (strong scale change breaks the equidistant sampling).
