@@ -340,8 +340,10 @@ FrameUpdateStats DepthMapper::UpdateWithFrame(const cv::Mat& image, const SE3& c
     }
     lines = &kept;
   }
-  // The largest standard deviation of a new hypothesis, relative to the map's scale (0: none).
-  const double max_new_sigma = options_.new_hypothesis_max_relative_sigma * MeanInverseDepth(map_);
+  // The largest standard deviation of a new hypothesis, relative to the map's scale (0: none;
+  // the pass over the map only when the gate is on).
+  const double ratio = options_.new_hypothesis_max_relative_sigma;
+  const double max_new_sigma = ratio > 0.0 ? ratio * MeanInverseDepth(map_) : 0.0;
   // Two passes (edge pixels, then the rest) so that each is timed on its own, each in stripes of
   // pixels (pixel_stripes.h).
   const int stripes = NumStripes(options_);
