@@ -53,6 +53,8 @@ void FrameUpdateStats::AddCounts(const FrameUpdateStats& other) {
   created += other.created;
   not_created += other.not_created;
   outliers += other.outliers;
+  removed += other.removed;
+  filled += other.filled;
   num_edge_pixels += other.num_edge_pixels;
 }
 

@@ -75,7 +75,8 @@ struct FrameUpdateStats {
   double edge_stereo_ms = 0.0;   // wall time of the stereo on edge pixels
   double other_stereo_ms = 0.0;  // wall time of the stereo on all other pixels
 
-  // Adds the per-pixel counters of `other` (line_* to not_created, num_edge_pixels).
+  // Adds the counters of `other` (line_* to filled, num_edge_pixels; not the times or the
+  // dropped matches).
   void AddCounts(const FrameUpdateStats& other);
 };
 

@@ -231,8 +231,6 @@ void MappingWorker::Run(const MappingJob& job) {
         if (updates_since_random_init_ >= 0) ++updates_since_random_init_;
         std::lock_guard<std::mutex> lock(mutex_);
         stereo_counts_.AddCounts(counts);
-        stereo_counts_.removed += counts.removed;
-        stereo_counts_.filled += counts.filled;
         break;
       }
       case MappingJob::Kind::kLineDepths:
