@@ -15,7 +15,7 @@
 #                        '^(lowtex|boxes)_s1$'); default all
 #   PLDVO_BENCH_JOBS     runs in parallel (default 2)
 #   PLDVO_BENCH_SET      extra `--set key=value` arguments for every run (default none; e.g.
-#                        '--set odometry.mapping_lag=1', the map one frame update behind)
+#                        '--set odometry.mapping_lag=0', the map of every earlier frame)
 #   PLDVO_TUM_RPY, PLDVO_KITTI  the real sequences (default ../shared/data/tum_fr1_rpy and
 #                        ../shared/data/kitti00_first200 relative to the repository; skipped with
 #                        a message when absent)

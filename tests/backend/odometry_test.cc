@@ -170,28 +170,35 @@ TEST(OdometryTest, FramesOnTheRandomStartMapAreTrackedWithoutTheLineTerm) {
     for (const LevelResult& level : frame.tracking.levels) rows += level.line_rows;
     return rows;
   };
-  for (const int warmup : {1, OdometryConfig().odometry.random_map_warmup_updates}) {
-    SCOPED_TRACE("random_map_warmup_updates " + std::to_string(warmup));
-    OdometryConfig config;
-    config.odometry.parallel_mapping = false;
-    config.odometry.random_map_warmup_updates = warmup;
-    config.odometry.line_consensus_max_cost_drop = 0.0;
-    const RunResult run = RunSequence(config, {}, warmup + 4);
-    int frames_with_line_term = 0;
-    for (const OdometryFrameResult& frame : run.frames) {
-      if (frame.index == 0) continue;
-      ASSERT_TRUE(IsTracked(frame.status)) << "frame " << frame.index;
-      ASSERT_GT(frame.num_matches, 0) << "frame " << frame.index;
-      EXPECT_EQ(frame.line_term_withheld, frame.index <= warmup) << "frame " << frame.index;
-      if (frame.index <= warmup) {
-        EXPECT_EQ(line_rows(frame), 0) << "frame " << frame.index;
-      } else {
-        EXPECT_GT(line_rows(frame), 0) << "frame " << frame.index;
-        ++frames_with_line_term;
+  // The warm-up counts the stereo updates in the map a frame is tracked against: frame k's map
+  // holds those of frames 0 .. k - 1 - mapping_lag.
+  for (const int lag : {0, 1}) {
+    for (const int warmup : {1, OdometryConfig().odometry.random_map_warmup_updates}) {
+      SCOPED_TRACE("mapping_lag " + std::to_string(lag) + ", random_map_warmup_updates " +
+                   std::to_string(warmup));
+      OdometryConfig config;
+      config.odometry.parallel_mapping = false;
+      config.odometry.mapping_lag = lag;
+      config.odometry.random_map_warmup_updates = warmup;
+      config.odometry.line_consensus_max_cost_drop = 0.0;
+      const int withheld = warmup + lag;
+      const RunResult run = RunSequence(config, {}, withheld + 4);
+      int frames_with_line_term = 0;
+      for (const OdometryFrameResult& frame : run.frames) {
+        if (frame.index == 0) continue;
+        ASSERT_TRUE(IsTracked(frame.status)) << "frame " << frame.index;
+        ASSERT_GT(frame.num_matches, 0) << "frame " << frame.index;
+        EXPECT_EQ(frame.line_term_withheld, frame.index <= withheld) << "frame " << frame.index;
+        if (frame.index <= withheld) {
+          EXPECT_EQ(line_rows(frame), 0) << "frame " << frame.index;
+        } else {
+          EXPECT_GT(line_rows(frame), 0) << "frame " << frame.index;
+          ++frames_with_line_term;
+        }
       }
+      EXPECT_EQ(frames_with_line_term, static_cast<int>(run.frames.size()) - 1 - withheld);
+      EXPECT_EQ(run.stats.line_term_withheld, withheld);
     }
-    EXPECT_EQ(frames_with_line_term, static_cast<int>(run.frames.size()) - 1 - warmup);
-    EXPECT_EQ(run.stats.line_term_withheld, warmup);
   }
   OdometryConfig paper;
   paper.odometry.parallel_mapping = false;
