@@ -624,7 +624,8 @@ SequenceRunResult SequenceRunner::Run() {
   summary["parallel_mapping"] = config_.odometry.parallel_mapping;
   summary["frontend_thread"] = config_.odometry.frontend_thread;
   summary["seconds"] = run_seconds;
-  // --realtime: frames dropped because the odometry could not take them in time.
+  // Frames the loop took, from initial.first_frame on; --realtime: frames dropped because the
+  // odometry could not take them in time.
   summary["realtime"] = options_.realtime;
   summary["processed_frames"] = processed;
   summary["dropped_frames"] = options_.realtime ? live.dropped().size() : 0;
