@@ -88,6 +88,7 @@ alternative_poses	odometry.try_alternatives=true	odometry.try_alternatives=false
 point_budget_4000	mapping.max_reference_points=4000	mapping.max_reference_points=0	At most 4000 tracking reference points per pyramid level: bounds the tracking time.
 rms_keyframes	keyframes.max_rms_growth=1.5	keyframes.max_rms_growth=0	A new keyframe when the frame's photometric misfit exceeds 1.5x the smallest since the keyframe (DSO's criterion): a keyframe that explains the image worse and worse (exposure drift, a wrong motion) is replaced early (docs/odometry.md).
 rows_per_edge_50	tracking.problem.max_rows_per_edge=50	tracking.problem.max_rows_per_edge=0	The photometric rows of one keyframe edge count as at most 50 points: an edge whose points share one wrong depth (an occluding edge that splits) cannot outvote the rest of the view through the row-wise robust loss (docs/tracking.md).
+new_hypothesis_prior	mapping.new_hypothesis_prior_relative_sigma=1	mapping.new_hypothesis_prior_relative_sigma=0	Fuses a new hypothesis' first observation with a prior at the map's mean inverse depth (sigma: that mean): alone, millimetre-baseline searches land anywhere on the range and sit on its near side (docs/mapping.md, "New hypotheses").
 no_line_regularisation	mapping.line_regularization=false	mapping.line_regularization=true	Leaves out the paper's 3D line regularisation (eqs. 11-13), which made points_lines worse on most of the development set (docs/mapping.md).
 TSV
 

@@ -200,8 +200,8 @@ bool DepthMapper::UninformativeSearch(int index, const Eigen::Vector2d& pixel,
 
 void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
                               const EpipolarGeometry& geometry,
-                              const std::vector<MatchedLine>& lines_in_cur, double max_new_sigma,
-                              FrameUpdateStats* stats) {
+                              const std::vector<MatchedLine>& lines_in_cur,
+                              const NewHypothesisRule& rule, FrameUpdateStats* stats) {
   const Eigen::Vector2d pixel(index % map_.width(), index / map_.width());
   const bool valid = map_.valid(index);
   double idepth_min, idepth_max, idepth_centre;
@@ -297,15 +297,38 @@ void DepthMapper::UpdatePixel(int index, const ImagePyramid& current,
       ++stats->outliers;
     }
   } else {
-    if (max_new_sigma > 0.0 && observation.idepth_var > max_new_sigma * max_new_sigma) {
+    if (rule.max_sigma > 0.0 && observation.idepth_var > rule.max_sigma * rule.max_sigma) {
       ++stats->not_created;
       return;
     }
-    map_.Set(index, observation.idepth, observation.idepth_var, options_.validity_initial,
-             std::sqrt(correlation * observation.idepth_var));
+    // With a prior, the hypothesis is its inverse-variance fusion with the observation; the
+    // observation's weight w scales the shared error's standard deviation too.
+    double idepth = observation.idepth;
+    double idepth_var = observation.idepth_var;
+    double w = 1.0;
+    if (rule.prior_var > 0.0) {
+      w = rule.prior_var / (rule.prior_var + observation.idepth_var);
+      idepth = rule.prior_idepth + w * (observation.idepth - rule.prior_idepth);
+      idepth_var = w * observation.idepth_var;
+    }
+    map_.Set(index, idepth, idepth_var, options_.validity_initial,
+             w * std::sqrt(correlation * observation.idepth_var));
     map_.CountObservation(index);
     ++stats->created;
   }
+}
+
+DepthMapper::NewHypothesisRule DepthMapper::MakeNewHypothesisRule() const {
+  NewHypothesisRule rule;
+  const double gate = options_.new_hypothesis_max_relative_sigma;
+  const double prior = options_.new_hypothesis_prior_relative_sigma;
+  if (gate <= 0.0 && prior <= 0.0) return rule;  // no pass over the map
+  // Relative to the map's scale; a map without hypotheses (mean 0) has none: no gate, no prior.
+  const double mean = MeanInverseDepth(map_);
+  rule.max_sigma = gate * mean;
+  rule.prior_idepth = mean;
+  rule.prior_var = (prior * mean) * (prior * mean);
+  return rule;
 }
 
 FrameUpdateStats DepthMapper::UpdateWithFrame(const cv::Mat& image, const SE3& cur_from_ref,
@@ -342,10 +365,7 @@ FrameUpdateStats DepthMapper::UpdateWithFrame(const cv::Mat& image, const SE3& c
     }
     lines = &kept;
   }
-  // The largest standard deviation of a new hypothesis, relative to the map's scale (0: none;
-  // the pass over the map only when the gate is on).
-  const double ratio = options_.new_hypothesis_max_relative_sigma;
-  const double max_new_sigma = ratio > 0.0 ? ratio * MeanInverseDepth(map_) : 0.0;
+  const NewHypothesisRule new_hypothesis = MakeNewHypothesisRule();
   // Two passes (edge pixels, then the rest) so that each is timed on its own, each in stripes of
   // pixels (pixel_stripes.h).
   const int stripes = NumStripes(options_);
@@ -359,7 +379,7 @@ FrameUpdateStats DepthMapper::UpdateWithFrame(const cv::Mat& image, const SE3& c
         if (!map_.candidate(i) || (map_.edge_id(i) >= 0) != (pass == 0)) continue;
         if (map_.blacklist(i) >= options_.blacklist_threshold) continue;
         if (pass == 0) ++counts->num_edge_pixels;
-        UpdatePixel(i, current, geometry, *lines, max_new_sigma, counts);
+        UpdatePixel(i, current, geometry, *lines, new_hypothesis, counts);
       }
     });
     for (const FrameUpdateStats& counts : stripe_stats) stats.AddCounts(counts);

@@ -202,10 +202,17 @@ class DepthMapper {
   bool UninformativeSearch(int index, const Eigen::Vector2d& pixel,
                            const EpipolarGeometry& geometry, const EpipolarPatch& patch,
                            double idepth_min, double idepth_max) const;
-  // Stereo + fusion of one candidate pixel; a new hypothesis needs an observation standard
-  // deviation of at most max_new_sigma (0: no limit).
+  // How a pixel without a hypothesis gets one, from the map's mean inverse depth and the
+  // options new_hypothesis_max_relative_sigma and new_hypothesis_prior_relative_sigma.
+  struct NewHypothesisRule {
+    double max_sigma = 0.0;  // largest observation standard deviation that creates (0: any)
+    double prior_idepth = 0.0;
+    double prior_var = 0.0;  // 0: the observation alone
+  };
+  NewHypothesisRule MakeNewHypothesisRule() const;
+  // Stereo + fusion of one candidate pixel; a new hypothesis follows `rule`.
   void UpdatePixel(int index, const ImagePyramid& current, const EpipolarGeometry& geometry,
-                   const std::vector<MatchedLine>& lines_in_cur, double max_new_sigma,
+                   const std::vector<MatchedLine>& lines_in_cur, const NewHypothesisRule& rule,
                    FrameUpdateStats* stats);
 
   PinholeCamera camera_;

@@ -40,6 +40,10 @@ std::string MappingOptions::Check() const {
         std::isfinite(new_hypothesis_max_relative_sigma))) {
     error << "new_hypothesis_max_relative_sigma must be finite and >= 0; ";
   }
+  if (!(new_hypothesis_prior_relative_sigma >= 0.0 &&
+        std::isfinite(new_hypothesis_prior_relative_sigma))) {
+    error << "new_hypothesis_prior_relative_sigma must be finite and >= 0; ";
+  }
   if (max_epipolar_scale < 1.0) error << "max_epipolar_scale must be >= 1; ";
   if (!(line_stereo_min_interval_px >= 0.0)) error << "line_stereo_min_interval_px must be >= 0; ";
   if (min_line_epipolar_angle_deg < 0.0 || min_line_epipolar_angle_deg >= 90.0) {

@@ -89,6 +89,10 @@ struct MappingOptions {
   // range, and such hypotheses shrink the map keyframe by keyframe. 0: always create (so does a
   // map without hypotheses, which has no scale yet).
   double new_hypothesis_max_relative_sigma = 0.0;
+  // A new hypothesis is the observation fused with a prior at the map's mean inverse depth whose
+  // standard deviation is this times that mean (a Bayesian start: an observation at a millimetre
+  // baseline, as uncertain as the prior, moves it half way). 0: the observation alone.
+  double new_hypothesis_prior_relative_sigma = 1.0;
   // A 1-px keyframe step along the epipolar line must map to [1/s, s] px in the current frame
   // (strong scale change breaks the equidistant sampling).
   double max_epipolar_scale = 2.0;
@@ -267,6 +271,9 @@ struct MappingOptions {
     v.Field("new_hypothesis_max_relative_sigma", &new_hypothesis_max_relative_sigma,
             "Create a hypothesis only when the observation's standard deviation is at most this "
             "times the map's mean inverse depth (0: always; default 0).");
+    v.Field("new_hypothesis_prior_relative_sigma", &new_hypothesis_prior_relative_sigma,
+            "Fuse a new hypothesis with a prior at the map's mean inverse depth of standard "
+            "deviation this times that mean (0: the observation alone; default 1).");
     v.Field("max_epipolar_scale", &max_epipolar_scale,
             "Maximum scale change along the epipolar line (default 2).");
     v.Field("use_line_stereo", &use_line_stereo, "Line-guided stereo on matched edges.");

@@ -697,7 +697,10 @@ void Odometry::CompareSolvers(const ImagePyramid& pyramid, const TrackingResult&
   result->compared = true;
   result->compared_status = other.status;
   result->world_from_cam_compared = keyframe_.world_from_kf * other.cur_from_ref.Inverse();
-  if (!other.levels.empty()) result->compared_final_cost = other.levels.back().final_cost;
+  if (!other.levels.empty()) {
+    result->compared_initial_cost = other.levels.back().initial_cost;
+    result->compared_final_cost = other.levels.back().final_cost;
+  }
   result->compared_valid_residuals = other.valid_residuals;
 }
 

@@ -80,8 +80,11 @@ struct OdometryFrameResult {
   bool compared = false;
   TrackingStatus compared_status = TrackingStatus::kLost;
   SE3 world_from_cam_compared;  // its pose, with this run's keyframe pose
-  // Its finest level's final cost and valid rows (the run's: tracking.levels.back().final_cost,
-  // tracking.valid_residuals): which solver stopped lower where the poses differ.
+  // Its finest level's initial and final cost and valid rows (the run's:
+  // tracking.levels.back().initial_cost / final_cost, tracking.valid_residuals): which solver
+  // stopped lower where the poses differ. Each solver starts a level where it left the coarser
+  // one, so the finest level's starts differ a little too.
+  double compared_initial_cost = 0.0;
   double compared_final_cost = 0.0;
   int compared_valid_residuals = 0;
 };

@@ -1,4 +1,5 @@
-// New hypotheses only from precise observations (mapping.new_hypothesis_max_relative_sigma,
+// New hypotheses only from precise observations (mapping.new_hypothesis_max_relative_sigma) or
+// fused with a prior at the map's mean (mapping.new_hypothesis_prior_relative_sigma;
 // docs/mapping.md "Photometric stereo"). Scene: a fronto-parallel plane at 1 m with a blurred
 // random texture, seen by a camera translating along x; the keyframe's map holds the true depth
 // on the left half of the image (mean inverse depth 1 1/m) and nothing on the right half, whose
@@ -35,9 +36,10 @@ cv::Mat ImageAt(const cv::Mat& texture, double baseline, int seed) {
   return image + noise;
 }
 
-DepthMapper HalfMappedKeyframe(const cv::Mat& texture, double ratio) {
+DepthMapper HalfMappedKeyframe(const cv::Mat& texture, double ratio, double prior = 0.0) {
   MappingOptions options;
   options.new_hypothesis_max_relative_sigma = ratio;
+  options.new_hypothesis_prior_relative_sigma = prior;
   options.regularize = false;  // compare the stereo updates alone
   DepthMapper mapper(kCamera, options);
   cv::Mat depth(kCamera.height, kCamera.width, CV_32F, cv::Scalar(0.0f));
@@ -94,6 +96,50 @@ TEST(NewHypothesisGateTest, OnlyPreciseObservationsCreateHypotheses) {
   }
 }
 
+// With a prior (mapping.new_hypothesis_prior_relative_sigma p), every new hypothesis is the
+// inverse-variance fusion of the same observation with N(mean, (p mean)^2): created where the
+// observation alone creates, at prior + w (observation - prior) with variance w V_obs, w = p^2
+// mean^2 / (p^2 mean^2 + V_obs). At 2 mm that pulls the near-side draws most of the way back (the
+// plane is at the map's mean here, the prior's best case; the exact fusion is what the test holds).
+TEST(NewHypothesisGateTest, APriorAtTheMeanIsFusedIntoEveryNewHypothesis) {
+  constexpr double kPrior = 1.0;
+  const cv::Mat texture = test::BlurredNoiseTexture(11);
+  for (const double baseline : {0.002, 0.05}) {
+    DepthMapper alone = HalfMappedKeyframe(texture, 0.0);
+    DepthMapper fused = HalfMappedKeyframe(texture, 0.0, kPrior);
+    const SemiDenseDepthMap before = alone.depth_map();
+    const double mean = MeanInverseDepth(before);
+    ASSERT_DOUBLE_EQ(mean, 1.0 / kPlaneDepth);
+    const cv::Mat image = ImageAt(texture, baseline, 2);
+    const SE3 cur_from_ref = test::TranslatedCurFromRef(baseline);
+    const FrameUpdateStats a = alone.UpdateWithFrame(image, cur_from_ref, {});
+    const FrameUpdateStats b = fused.UpdateWithFrame(image, cur_from_ref, {});
+    ASSERT_GT(a.created, 1000);
+    EXPECT_EQ(b.created, a.created);
+    EXPECT_EQ(b.not_created, 0);
+    const double prior_var = kPrior * kPrior * mean * mean;
+    std::vector<double> errors_alone, errors_fused;
+    for (int i = 0; i < before.num_pixels(); ++i) {
+      if (before.valid(i) || !alone.depth_map().valid(i)) continue;
+      ASSERT_TRUE(fused.depth_map().valid(i));
+      const double obs = alone.depth_map().idepth(i);
+      const double obs_var = alone.depth_map().idepth_var(i);
+      const double w = prior_var / (prior_var + obs_var);
+      EXPECT_NEAR(fused.depth_map().idepth(i), mean + w * (obs - mean), 1e-5 * (1.0 + obs));
+      EXPECT_NEAR(fused.depth_map().idepth_var(i), w * obs_var, 1e-5 * obs_var);
+      errors_alone.push_back(std::abs(obs - 1.0 / kPlaneDepth));
+      errors_fused.push_back(std::abs(fused.depth_map().idepth(i) - 1.0 / kPlaneDepth));
+    }
+    std::printf("baseline %.3f m: median |error| %.3f alone, %.3f with the prior\n", baseline,
+                Median(errors_alone), Median(errors_fused));
+    if (baseline < 0.005) {
+      EXPECT_LT(Median(errors_fused), 0.5 * Median(errors_alone));
+    } else {
+      EXPECT_LT(Median(errors_fused), 0.03);  // precise observations keep nearly all their weight
+    }
+  }
+}
+
 // A map without hypotheses has no scale to compare with: it creates as without the gate.
 TEST(NewHypothesisGateTest, AnEmptyMapCreatesAsWithoutTheGate) {
   const cv::Mat texture = test::BlurredNoiseTexture(11);
@@ -114,13 +160,17 @@ TEST(NewHypothesisGateTest, AnEmptyMapCreatesAsWithoutTheGate) {
   EXPECT_EQ(some.not_created, 0);
 }
 
-// A negative or infinite ratio is a configuration error.
-TEST(NewHypothesisGateTest, TheRatioMustBeFiniteAndNonNegative) {
+// A negative or infinite ratio or prior is a configuration error.
+TEST(NewHypothesisGateTest, TheRatioAndThePriorMustBeFiniteAndNonNegative) {
   MappingOptions options;
   EXPECT_EQ(options.Check(), "");
   for (const double bad : {-1.0, std::numeric_limits<double>::infinity()}) {
     options.new_hypothesis_max_relative_sigma = bad;
     EXPECT_NE(options.Check().find("new_hypothesis_max_relative_sigma"), std::string::npos);
+    options.new_hypothesis_max_relative_sigma = 0.0;
+    options.new_hypothesis_prior_relative_sigma = bad;
+    EXPECT_NE(options.Check().find("new_hypothesis_prior_relative_sigma"), std::string::npos);
+    options.new_hypothesis_prior_relative_sigma = 0.0;
   }
 }
 
